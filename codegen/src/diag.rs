@@ -1,0 +1,220 @@
+//! Diagnostics: every problem found in an input, with file, line, section and
+//! key, rendered with the source line by codespan-reporting.
+
+use std::fmt;
+use std::ops::Range;
+
+use codespan_reporting::diagnostic::{Diagnostic as CsDiagnostic, Label};
+use codespan_reporting::files::SimpleFiles;
+use codespan_reporting::term;
+
+/// How bad a diagnostic is.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Severity {
+    Warning,
+    Error,
+}
+
+impl Severity {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Severity::Warning => "warning",
+            Severity::Error => "error",
+        }
+    }
+}
+
+/// Where in a source file a diagnostic points.
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct Location {
+    /// 1-based line number.
+    pub line: Option<u32>,
+    /// Byte range in the decoded source text, used to underline the culprit.
+    pub span: Option<Range<usize>>,
+    /// Section name as written in the source (without brackets).
+    pub section: Option<String>,
+    /// Key name as written in the source.
+    pub key: Option<String>,
+}
+
+/// One problem in one input file.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Diagnostic {
+    pub severity: Severity,
+    /// A stable rule name such as `eds::unknown-data-type`, for tests and filtering.
+    pub code: &'static str,
+    pub file: String,
+    pub location: Location,
+    pub message: String,
+    /// Extra explanation lines (what was done about it, what to write instead).
+    pub notes: Vec<String>,
+}
+
+impl Diagnostic {
+    /// The message prefixed with `[section] key: ` where those are known.
+    pub fn headline(&self) -> String {
+        let mut s = String::new();
+        if let Some(section) = &self.location.section {
+            s.push('[');
+            s.push_str(section);
+            s.push_str("] ");
+        }
+        if let Some(key) = &self.location.key {
+            s.push_str(key);
+            s.push_str(": ");
+        }
+        s.push_str(&self.message);
+        s
+    }
+}
+
+impl fmt::Display for Diagnostic {
+    /// One line: `file:line: severity: [section] key: message`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.file)?;
+        if let Some(line) = self.location.line {
+            write!(f, ":{line}")?;
+        }
+        write!(f, ": {}: {}", self.severity.as_str(), self.headline())
+    }
+}
+
+/// All diagnostics of one run, with the source texts they point into.
+#[derive(Debug, Clone, Default)]
+pub struct Diagnostics {
+    items: Vec<Diagnostic>,
+    sources: Vec<(String, String)>,
+}
+
+impl Diagnostics {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Registers the decoded text of a file so rendering can show its lines.
+    pub fn add_source(&mut self, file: &str, text: &str) {
+        if !self.sources.iter().any(|(name, _)| name == file) {
+            self.sources.push((file.to_string(), text.to_string()));
+        }
+    }
+
+    pub fn push(&mut self, diagnostic: Diagnostic) {
+        self.items.push(diagnostic);
+    }
+
+    pub fn extend(&mut self, other: Diagnostics) {
+        for (file, text) in &other.sources {
+            self.add_source(file, text);
+        }
+        self.items.extend(other.items);
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
+        self.items.iter()
+    }
+
+    pub fn len(&self) -> usize {
+        self.items.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.items.is_empty()
+    }
+
+    pub fn has_errors(&self) -> bool {
+        self.items.iter().any(|d| d.severity == Severity::Error)
+    }
+
+    pub fn error_count(&self) -> usize {
+        self.items
+            .iter()
+            .filter(|d| d.severity == Severity::Error)
+            .count()
+    }
+
+    pub fn warning_count(&self) -> usize {
+        self.items.len() - self.error_count()
+    }
+
+    /// Turns every warning into an error (`--strict`).
+    pub fn make_strict(&mut self) {
+        for d in &mut self.items {
+            d.severity = Severity::Error;
+        }
+    }
+
+    /// Sorts by file, then line, keeping the order of diagnostics on one line.
+    pub fn sort(&mut self) {
+        self.items
+            .sort_by(|a, b| (&a.file, a.location.line).cmp(&(&b.file, b.location.line)));
+    }
+
+    /// Renders every diagnostic with its source line, without colours.
+    pub fn render(&self) -> String {
+        let mut files = SimpleFiles::new();
+        let ids: Vec<(String, usize)> = self
+            .sources
+            .iter()
+            .map(|(name, text)| (name.clone(), files.add(name.clone(), text.clone())))
+            .collect();
+        let config = term::Config::default();
+        let mut out = String::new();
+        for d in &self.items {
+            let id = ids
+                .iter()
+                .find(|(name, _)| *name == d.file)
+                .map(|(_, id)| *id);
+            let cs = match (id, &d.location.span) {
+                (Some(id), Some(span)) => {
+                    let severity = match d.severity {
+                        Severity::Error => codespan_reporting::diagnostic::Severity::Error,
+                        Severity::Warning => codespan_reporting::diagnostic::Severity::Warning,
+                    };
+                    CsDiagnostic::new(severity)
+                        .with_code(d.code)
+                        .with_message(d.headline())
+                        .with_labels(vec![Label::primary(id, span.clone())])
+                        .with_notes(d.notes.clone())
+                }
+                _ => {
+                    // No source position: a one-line rendering that still names the file.
+                    out.push_str(&format!(
+                        "{}[{}]: {}\n",
+                        d.severity.as_str(),
+                        d.code,
+                        d.headline()
+                    ));
+                    out.push_str(&format!("  = in {}\n", d.file));
+                    for note in &d.notes {
+                        out.push_str(&format!("  = {note}\n"));
+                    }
+                    out.push('\n');
+                    continue;
+                }
+            };
+            let mut buf = String::new();
+            if term::emit_to_string(&mut buf, &config, &files, &cs).is_err() {
+                buf = format!("{d}\n");
+            }
+            out.push_str(&buf);
+            out.push('\n');
+        }
+        out
+    }
+}
+
+impl fmt::Display for Diagnostics {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.render())
+    }
+}
+
+impl std::error::Error for Diagnostics {}
+
+impl IntoIterator for Diagnostics {
+    type Item = Diagnostic;
+    type IntoIter = std::vec::IntoIter<Diagnostic>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.items.into_iter()
+    }
+}

@@ -1,0 +1,3 @@
+//! Dumps of the IR for tools and tests.
+
+pub mod json;

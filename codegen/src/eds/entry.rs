@@ -1,0 +1,287 @@
+//! Lowering of one value-carrying section (a VAR or a sub-object) into an [`Entry`].
+
+use super::ini::{Property, Section};
+use super::lower::Lowering;
+use super::number::{self, parse_value};
+use crate::ir::{Access, DataType, Entry, Literal, ObjectKind, Origin, Value};
+
+impl Lowering<'_> {
+    /// Reads one entry. `kind` is the object's kind for a VAR/DOMAIN/DEFTYPE
+    /// (sub 0), `Var` for sub-objects. `None` when the entry has no meaning.
+    pub(super) fn entry(
+        &mut self,
+        index: u16,
+        sub: u8,
+        section: &Section,
+        kind: ObjectKind,
+    ) -> Option<Entry> {
+        let fallback = if sub == 0 {
+            format!("Object 0x{index:04X}")
+        } else {
+            format!("Sub-index {sub}")
+        };
+        let name = match section.get("ParameterName").filter(|p| !p.value.is_empty()) {
+            Some(p) => p.value.clone(),
+            None => {
+                self.report(
+                    crate::diag::Severity::Warning,
+                    "eds::missing-name",
+                    section,
+                    None,
+                    format!("no ParameterName; named `{fallback}`"),
+                );
+                fallback
+            }
+        };
+        let data_type = match section.get("DataType").filter(|p| !p.value.is_empty()) {
+            None if kind == ObjectKind::Domain => DataType::Domain,
+            None => {
+                self.report(
+                    crate::diag::Severity::Error,
+                    "eds::missing-data-type",
+                    section,
+                    None,
+                    "no DataType; the entry has no meaning without one and is left out".into(),
+                );
+                return None;
+            }
+            Some(p) => match number::parse_int(&p.value)
+                .ok()
+                .and_then(|v| u16::try_from(v).ok())
+            {
+                None => {
+                    self.report(
+                        crate::diag::Severity::Error,
+                        "eds::bad-data-type",
+                        section,
+                        Some(p),
+                        format!(
+                            "`{}` is not a data type code; the entry is left out",
+                            p.value
+                        ),
+                    );
+                    return None;
+                }
+                Some(code) => {
+                    let data_type = DataType::from_code(code);
+                    if let DataType::Other(code) = data_type {
+                        let note = if self.doc.section(&format!("{code:04X}")).is_some() {
+                            " (a DEFTYPE/DEFSTRUCT of this file)"
+                        } else {
+                            ""
+                        };
+                        self.report(crate::diag::Severity::Warning, "eds::unknown-data-type", section, Some(p), format!("data type {code:#06x}{note} is not a CiA 301 basic type (0x0001–0x001B); values of this entry are kept as text"));
+                    }
+                    data_type
+                }
+            },
+        };
+        let access = match section.get("AccessType").filter(|p| !p.value.is_empty()) {
+            None => {
+                let access = if kind == ObjectKind::DefType {
+                    Access::Const
+                } else {
+                    Access::Ro
+                };
+                if kind != ObjectKind::DefType {
+                    self.report(
+                        crate::diag::Severity::Warning,
+                        "eds::missing-access",
+                        section,
+                        None,
+                        "no AccessType; read as `ro`".into(),
+                    );
+                }
+                access
+            }
+            Some(p) => match p.value.trim().to_ascii_lowercase().as_str() {
+                "ro" => Access::Ro,
+                "wo" => Access::Wo,
+                "rw" => Access::Rw,
+                "rwr" => Access::Rwr,
+                "rww" => Access::Rww,
+                "const" => Access::Const,
+                _ => {
+                    self.report(crate::diag::Severity::Error, "eds::bad-access", section, Some(p), format!("`{}` is not an access type (ro, wo, rw, rwr, rww, const); read as `ro`", p.value));
+                    Access::Ro
+                }
+            },
+        };
+        let pdo_mappable = match section.get("PDOMapping").filter(|p| !p.value.is_empty()) {
+            None => false,
+            Some(p) => match number::parse_int(&p.value) {
+                Ok(0) => false,
+                Ok(1) => true,
+                _ => {
+                    self.report(
+                        crate::diag::Severity::Warning,
+                        "eds::bad-pdo-mapping",
+                        section,
+                        Some(p),
+                        format!("PDOMapping must be 0 or 1, not `{}`; read as 0", p.value),
+                    );
+                    false
+                }
+            },
+        };
+        let value = |this: &mut Self, key: &str| -> Option<Literal> {
+            let p = section.get(key).filter(|p| !p.value.is_empty())?;
+            this.literal(section, p, data_type)
+        };
+        let default = value(self, "DefaultValue");
+        let low_limit = value(self, "LowLimit");
+        let high_limit = value(self, "HighLimit");
+        let parameter_value = value(self, "ParameterValue");
+        let obj_flags = match section.get("ObjFlags").filter(|p| !p.value.is_empty()) {
+            None => None,
+            Some(p) => match number::parse_int(&p.value)
+                .ok()
+                .and_then(|v| u32::try_from(v).ok())
+            {
+                Some(v) => Some(v),
+                None => {
+                    self.report(
+                        crate::diag::Severity::Warning,
+                        "eds::bad-number",
+                        section,
+                        Some(p),
+                        format!("ObjFlags `{}` is not a 32-bit number; ignored", p.value),
+                    );
+                    None
+                }
+            },
+        };
+        let denotation = section
+            .get("Denotation")
+            .map(|p| p.value.clone())
+            .filter(|v| !v.is_empty());
+        let entry = Entry {
+            subindex: sub,
+            name,
+            data_type,
+            access,
+            pdo_mappable,
+            default,
+            low_limit,
+            high_limit,
+            parameter_value,
+            obj_flags,
+            denotation,
+            origin: Origin {
+                file: self.doc.file.clone(),
+                line: section.line,
+            },
+        };
+        self.check_limits(section, &entry);
+        Some(entry)
+    }
+
+    /// Reads a value of `data_type` from a property; a bad value is a warning and gives `None`.
+    pub(super) fn literal(
+        &mut self,
+        section: &Section,
+        p: &Property,
+        data_type: DataType,
+    ) -> Option<Literal> {
+        let warn = |this: &mut Self, code, message| {
+            this.report(
+                crate::diag::Severity::Warning,
+                code,
+                section,
+                Some(p),
+                message,
+            )
+        };
+        match parse_value(&p.value, data_type) {
+            None => {
+                // Unknown type: keep an integer when it reads as one, else the text.
+                let value = match number::parse_int_expr(&p.value) {
+                    Ok((v, rel)) => {
+                        return Some(Literal {
+                            value: Value::Integer(v),
+                            plus_node_id: rel,
+                            text: p.value.clone(),
+                        });
+                    }
+                    Err(_) => Value::Text(p.value.clone()),
+                };
+                Some(Literal {
+                    value,
+                    plus_node_id: false,
+                    text: p.value.clone(),
+                })
+            }
+            Some(Ok(parsed)) => {
+                if let Some(w) = parsed.warning {
+                    warn(
+                        self,
+                        "eds::value-out-of-range",
+                        format!("{w}; kept as written"),
+                    );
+                }
+                Some(parsed.literal)
+            }
+            Some(Err(e)) => {
+                warn(
+                    self,
+                    "eds::bad-value",
+                    format!("{} for {}; the value is ignored", e.0, data_type.name()),
+                );
+                None
+            }
+        }
+    }
+
+    /// Low limit above high limit, or a default outside the limits.
+    fn check_limits(&mut self, section: &Section, entry: &Entry) {
+        let num = |l: &Option<Literal>| match l.as_ref().map(|l| (&l.value, l.plus_node_id)) {
+            Some((Value::Integer(v), false)) => Some(*v as f64),
+            Some((Value::Real(v), false)) => Some(*v),
+            _ => None,
+        };
+        let (low, high, default) = (
+            num(&entry.low_limit),
+            num(&entry.high_limit),
+            num(&entry.default),
+        );
+        if let (Some(lo), Some(hi)) = (low, high) {
+            if lo > hi {
+                let p = section.get("LowLimit");
+                self.report(
+                    crate::diag::Severity::Warning,
+                    "eds::limits",
+                    section,
+                    p,
+                    format!(
+                        "LowLimit {} is above HighLimit {}",
+                        entry.low_limit.as_ref().map_or("", |l| &l.text),
+                        entry.high_limit.as_ref().map_or("", |l| &l.text)
+                    ),
+                );
+                return;
+            }
+        }
+        if let Some(d) = default {
+            let below = low.is_some_and(|lo| d < lo);
+            let above = high.is_some_and(|hi| d > hi);
+            if below || above {
+                let p = section.get("DefaultValue");
+                let which = if below {
+                    "below LowLimit"
+                } else {
+                    "above HighLimit"
+                };
+                self.report(
+                    crate::diag::Severity::Warning,
+                    "eds::limits",
+                    section,
+                    p,
+                    format!(
+                        "DefaultValue {} is {which}",
+                        entry.default.as_ref().map_or("", |l| &l.text)
+                    ),
+                );
+            }
+        }
+    }
+}

@@ -1,0 +1,361 @@
+//! The INI layer of CiA 306: bytes → decoded text → sections of `key=value`.
+//!
+//! Rules (documented in docs/eds-reader.md):
+//! - The file is UTF-8 (a BOM is dropped); if it is not, it is decoded as
+//!   Windows-1252 (a superset of Latin-1's printable range) with a warning.
+//! - Lines end in LF or CRLF. Leading and trailing white space is ignored.
+//! - A line whose first non-blank character is `;` or `#` is a comment.
+//! - Section names and keys are matched without regard to case.
+//! - In values, a `;` preceded by white space starts a comment (as
+//!   python-canopen's INI parser does), except in free-text keys (names,
+//!   descriptions), where the whole rest of the line is the value. A `;` or `#`
+//!   not preceded by white space is always part of the value.
+//! - A repeated key in one section: the later one wins (warning). A repeated
+//!   section: its keys are merged into the first one, later keys winning
+//!   (warning).
+
+use std::collections::HashMap;
+use std::ops::Range;
+
+use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
+
+/// A `key=value` line.
+#[derive(Debug, Clone)]
+pub struct Property {
+    /// The key as written.
+    pub key: String,
+    /// The value, trimmed, with any inline comment removed.
+    pub value: String,
+    pub line: u32,
+    /// Byte range of the value in the decoded text (of the key when the value is empty).
+    pub value_span: Range<usize>,
+    /// Byte range of the whole line without its end-of-line.
+    pub line_span: Range<usize>,
+}
+
+/// One `[section]` with its properties.
+#[derive(Debug, Clone)]
+pub struct Section {
+    /// The name as written, without brackets.
+    pub name: String,
+    pub line: u32,
+    pub header_span: Range<usize>,
+    pub properties: Vec<Property>,
+}
+
+impl Section {
+    /// The property whose key matches `key` without regard to case.
+    pub fn get(&self, key: &str) -> Option<&Property> {
+        self.properties
+            .iter()
+            .find(|p| p.key.eq_ignore_ascii_case(key))
+    }
+}
+
+/// A parsed INI document.
+#[derive(Debug, Clone)]
+pub struct Document {
+    pub file: String,
+    pub text: String,
+    pub sections: Vec<Section>,
+    by_name: HashMap<String, usize>,
+}
+
+impl Document {
+    /// The section whose name matches `name` without regard to case.
+    pub fn section(&self, name: &str) -> Option<&Section> {
+        self.by_name
+            .get(&name.to_ascii_lowercase())
+            .map(|&i| &self.sections[i])
+    }
+}
+
+/// Keys whose values are free text: no inline comments are stripped there.
+fn is_free_text_key(key: &str) -> bool {
+    const KEYS: &[&str] = &[
+        "parametername",
+        "denotation",
+        "description",
+        "vendorname",
+        "productname",
+        "ordercode",
+        "createdby",
+        "modifiedby",
+        "filename",
+        "nodename",
+        "networkname",
+    ];
+    let lower = key.to_ascii_lowercase();
+    KEYS.contains(&lower.as_str()) || lower.starts_with("line")
+}
+
+/// Decodes the bytes of a file: UTF-8, else Windows-1252 with a warning.
+pub fn decode(file: &str, bytes: &[u8], diags: &mut Diagnostics) -> String {
+    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    match std::str::from_utf8(bytes) {
+        Ok(text) => text.to_string(),
+        Err(err) => {
+            let (text, _, _) = encoding_rs::WINDOWS_1252.decode(bytes);
+            let text = text.into_owned();
+            let offset = err.valid_up_to();
+            let line = bytes[..offset].iter().filter(|&&b| b == b'\n').count() as u32 + 1;
+            // The span is in the decoded text: count decoded chars up to the same line.
+            let start = line_start(&text, line);
+            let end = text[start..].find('\n').map_or(text.len(), |n| start + n);
+            diags.push(Diagnostic {
+                severity: Severity::Warning,
+                code: "eds::not-utf8",
+                file: file.to_string(),
+                location: Location {
+                    line: Some(line),
+                    span: Some(start..end.max(start)),
+                    ..Location::default()
+                },
+                message: format!(
+                    "the file is not valid UTF-8 (byte 0x{:02X} at line {line}); read as Windows-1252 (Latin-1)",
+                    bytes[offset]
+                ),
+                notes: vec!["save the file as UTF-8 to silence this warning".into()],
+            });
+            text
+        }
+    }
+}
+
+fn line_start(text: &str, line: u32) -> usize {
+    if line <= 1 {
+        return 0;
+    }
+    text.match_indices('\n')
+        .nth(line as usize - 2)
+        .map_or(text.len(), |(i, _)| i + 1)
+}
+
+/// Splits decoded text into sections. Problems of the INI layer are pushed to `diags`.
+pub fn parse(file: &str, text: String, diags: &mut Diagnostics) -> Document {
+    let mut sections: Vec<Section> = Vec::new();
+    let mut by_name: HashMap<String, usize> = HashMap::new();
+    // Index into `sections` of the section that receives properties now.
+    let mut current: Option<usize> = None;
+    let warn = |diags: &mut Diagnostics,
+                code,
+                line,
+                span: Range<usize>,
+                section: Option<&str>,
+                key: Option<&str>,
+                message: String| {
+        diags.push(Diagnostic {
+            severity: Severity::Warning,
+            code,
+            file: file.to_string(),
+            location: Location {
+                line: Some(line),
+                span: Some(span),
+                section: section.map(str::to_string),
+                key: key.map(str::to_string),
+            },
+            message,
+            notes: Vec::new(),
+        })
+    };
+
+    let mut offset = 0usize;
+    for (n, raw_line) in text.split('\n').enumerate() {
+        let line_no = n as u32 + 1;
+        let line_offset = offset;
+        offset += raw_line.len() + 1;
+        let content = raw_line.strip_suffix('\r').unwrap_or(raw_line);
+        let lead = content.len() - content.trim_start().len();
+        let trimmed = content.trim();
+        let line_span = line_offset + lead..line_offset + lead + trimmed.len();
+        if trimmed.is_empty() || trimmed.starts_with(';') || trimmed.starts_with('#') {
+            continue;
+        }
+        if let Some(rest) = trimmed.strip_prefix('[') {
+            let Some(close) = rest.find(']') else {
+                warn(
+                    diags,
+                    "eds::bad-section-header",
+                    line_no,
+                    line_span,
+                    None,
+                    None,
+                    format!("section header `{trimmed}` has no closing `]`; the line is ignored"),
+                );
+                current = None;
+                continue;
+            };
+            let name = rest[..close].trim().to_string();
+            let after = rest[close + 1..].trim();
+            if !after.is_empty() && !after.starts_with(';') && !after.starts_with('#') {
+                warn(
+                    diags,
+                    "eds::bad-section-header",
+                    line_no,
+                    line_span.clone(),
+                    Some(&name),
+                    None,
+                    format!("text after the section header is ignored: `{after}`"),
+                );
+            }
+            let key = name.to_ascii_lowercase();
+            if let Some(&existing) = by_name.get(&key) {
+                let first_line = sections[existing].line;
+                warn(
+                    diags,
+                    "eds::duplicate-section",
+                    line_no,
+                    line_span,
+                    Some(&name),
+                    None,
+                    format!(
+                        "section [{name}] appears again (first at line {first_line}); its keys are merged into the first, later keys win"
+                    ),
+                );
+                current = Some(existing);
+            } else {
+                by_name.insert(key, sections.len());
+                current = Some(sections.len());
+                sections.push(Section {
+                    name,
+                    line: line_no,
+                    header_span: line_span,
+                    properties: Vec::new(),
+                });
+            }
+            continue;
+        }
+        let Some(section_index) = current else {
+            warn(
+                diags,
+                "eds::outside-section",
+                line_no,
+                line_span,
+                None,
+                None,
+                "a line before the first section header is ignored".to_string(),
+            );
+            continue;
+        };
+        let section_name = sections[section_index].name.clone();
+        let Some(eq) = trimmed.find('=') else {
+            warn(
+                diags,
+                "eds::not-key-value",
+                line_no,
+                line_span,
+                Some(&section_name),
+                None,
+                "a line without `=` is ignored".to_string(),
+            );
+            continue;
+        };
+        let key = trimmed[..eq].trim().to_string();
+        if key.is_empty() {
+            warn(
+                diags,
+                "eds::not-key-value",
+                line_no,
+                line_span,
+                Some(&section_name),
+                None,
+                "a line with an empty key is ignored".to_string(),
+            );
+            continue;
+        }
+        let raw_value = &trimmed[eq + 1..];
+        let value_lead = raw_value.len() - raw_value.trim_start().len();
+        let mut value = raw_value.trim();
+        if !is_free_text_key(&key) {
+            value = strip_inline_comment(value);
+        }
+        let value_start = line_span.start + eq + 1 + value_lead;
+        let value_span = if value.is_empty() {
+            line_span.start..line_span.start + eq
+        } else {
+            value_start..value_start + value.len()
+        };
+        let property = Property {
+            key: key.clone(),
+            value: value.to_string(),
+            line: line_no,
+            value_span,
+            line_span: line_span.clone(),
+        };
+        let props = &mut sections[section_index].properties;
+        if let Some(pos) = props.iter().position(|p| p.key.eq_ignore_ascii_case(&key)) {
+            let first_line = props[pos].line;
+            props[pos] = property;
+            warn(
+                diags,
+                "eds::duplicate-key",
+                line_no,
+                line_span,
+                Some(&section_name),
+                Some(&key),
+                format!("key repeated (first at line {first_line}); this later value wins"),
+            );
+        } else {
+            props.push(property);
+        }
+    }
+    Document {
+        file: file.to_string(),
+        text,
+        sections,
+        by_name,
+    }
+}
+
+/// Cuts a value at the first `;` that follows white space.
+fn strip_inline_comment(value: &str) -> &str {
+    let bytes = value.as_bytes();
+    for i in 1..bytes.len() {
+        if bytes[i] == b';' && bytes[i - 1].is_ascii_whitespace() {
+            return value[..i].trim_end();
+        }
+    }
+    value
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn doc(text: &str) -> (Document, Diagnostics) {
+        let mut d = Diagnostics::new();
+        let doc = parse("t.eds", text.to_string(), &mut d);
+        (doc, d)
+    }
+
+    #[test]
+    fn comments_case_and_crlf() {
+        let (doc, d) =
+            doc("; head\r\n[fileINFO]\r\nFileName = a;b #c\r\nDefaultValue=0x10 ; note\r\n");
+        assert!(d.is_empty());
+        let s = doc.section("FileInfo").unwrap();
+        assert_eq!(s.get("filename").unwrap().value, "a;b #c");
+        assert_eq!(s.get("DEFAULTVALUE").unwrap().value, "0x10");
+        let p = s.get("defaultvalue").unwrap();
+        assert_eq!(&doc.text[p.value_span.clone()], "0x10");
+        assert_eq!(p.line, 4);
+    }
+
+    #[test]
+    fn duplicates_later_wins() {
+        let (doc, d) = doc("[1000]\na=1\nA=2\n[1000]\nb=3\n");
+        assert_eq!(d.len(), 2);
+        let s = doc.section("1000").unwrap();
+        assert_eq!(s.get("a").unwrap().value, "2");
+        assert_eq!(s.get("b").unwrap().value, "3");
+    }
+
+    #[test]
+    fn latin1_fallback() {
+        let mut d = Diagnostics::new();
+        let text = decode("t.eds", b"[Comments]\nLine1=Gr\xf6\xdfe\n", &mut d);
+        assert_eq!(text, "[Comments]\nLine1=Größe\n");
+        assert_eq!(d.len(), 1);
+        assert_eq!(d.iter().next().unwrap().location.line, Some(2));
+    }
+}

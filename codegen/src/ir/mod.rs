@@ -1,0 +1,201 @@
+//! The object-dictionary intermediate representation.
+//!
+//! Plain data, serde-serialisable, with no knowledge of Rust syntax and none of
+//! EDS syntax either: the EDS reader and the YAML table reader lower into it,
+//! the generators read from it. Every item carries its [`Origin`].
+
+mod datatype;
+mod value;
+
+use std::collections::BTreeMap;
+
+use serde::{Deserialize, Serialize};
+
+pub use datatype::{DataType, ValueKind};
+pub use value::{Literal, Value};
+
+/// Where an item came from: a file and a 1-based line.
+#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct Origin {
+    pub file: String,
+    pub line: u32,
+}
+
+/// One device's object dictionary.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Device {
+    /// Path of the main input file.
+    pub source: String,
+    pub file_info: FileInfo,
+    pub identity: Identity,
+    pub capabilities: Capabilities,
+    /// DCF `[DeviceComissioning]`, when present.
+    pub commissioning: Option<Commissioning>,
+    /// Data types the device accepts as dummy entries in PDO mappings.
+    pub dummy_usage: Vec<DataType>,
+    /// Objects keyed by index, including DEFTYPE/DEFSTRUCT type definitions.
+    pub objects: BTreeMap<u16, Object>,
+    /// Free text of the `[Comments]` section, line by line.
+    pub comments: Vec<String>,
+}
+
+/// File metadata (`[FileInfo]`), kept as written.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct FileInfo {
+    pub file_name: Option<String>,
+    pub file_version: Option<String>,
+    pub file_revision: Option<String>,
+    pub format_version: Option<String>,
+    pub description: Option<String>,
+    pub created_by: Option<String>,
+    pub creation_date: Option<String>,
+    pub creation_time: Option<String>,
+    pub modified_by: Option<String>,
+    pub modification_date: Option<String>,
+    pub modification_time: Option<String>,
+}
+
+/// Device identity (`[DeviceInfo]` and object 0x1018).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Identity {
+    pub vendor_name: Option<String>,
+    pub vendor_number: Option<u32>,
+    pub product_name: Option<String>,
+    pub product_number: Option<u32>,
+    pub revision_number: Option<u32>,
+    pub order_code: Option<String>,
+}
+
+/// What the device says it supports (`[DeviceInfo]`).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Capabilities {
+    /// Supported bit rates in kbit/s, ascending.
+    pub baud_rates: Vec<u32>,
+    pub simple_boot_up_master: Option<bool>,
+    pub simple_boot_up_slave: Option<bool>,
+    pub granularity: Option<u8>,
+    pub dynamic_channels_supported: Option<u8>,
+    pub group_messaging: Option<bool>,
+    pub nr_of_rx_pdo: Option<u16>,
+    pub nr_of_tx_pdo: Option<u16>,
+    pub lss_supported: Option<bool>,
+}
+
+/// DCF commissioning data (`[DeviceComissioning]`, CiA 306 spelling).
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Commissioning {
+    pub node_id: Option<u8>,
+    pub node_name: Option<String>,
+    /// Bit rate in kbit/s.
+    pub baud_rate: Option<u32>,
+    pub net_number: Option<u32>,
+    pub network_name: Option<String>,
+    pub canopen_manager: Option<bool>,
+    pub lss_serial_number: Option<u32>,
+}
+
+/// The CiA 301 object code.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "SCREAMING_SNAKE_CASE")]
+pub enum ObjectKind {
+    /// 0x5: a data type definition.
+    DefType,
+    /// 0x6: a record type definition.
+    DefStruct,
+    /// 0x7: a single value.
+    Var,
+    /// 0x8: sub-entries of one type.
+    Array,
+    /// 0x9: sub-entries of different types.
+    Record,
+    /// 0x2: a large block of data (a VAR of type DOMAIN is also common).
+    Domain,
+}
+
+impl ObjectKind {
+    pub fn code(self) -> u8 {
+        match self {
+            ObjectKind::Domain => 0x2,
+            ObjectKind::DefType => 0x5,
+            ObjectKind::DefStruct => 0x6,
+            ObjectKind::Var => 0x7,
+            ObjectKind::Array => 0x8,
+            ObjectKind::Record => 0x9,
+        }
+    }
+}
+
+/// One object of the dictionary.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Object {
+    pub index: u16,
+    pub name: String,
+    pub kind: ObjectKind,
+    /// For a VAR or DOMAIN the single entry has subindex 0.
+    pub entries: BTreeMap<u8, Entry>,
+    pub obj_flags: Option<u32>,
+    pub denotation: Option<String>,
+    /// Set when the sub-entries were expanded from `CompactSubObj`.
+    pub compact_sub_obj: Option<u8>,
+    pub origin: Origin,
+}
+
+/// Access right of an entry (CiA 306 AccessType).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Access {
+    Ro,
+    Wo,
+    Rw,
+    /// Read/write, mapped into a TPDO (read on process input).
+    Rwr,
+    /// Read/write, mapped into an RPDO (write on process output).
+    Rww,
+    Const,
+}
+
+impl Access {
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Access::Ro => "ro",
+            Access::Wo => "wo",
+            Access::Rw => "rw",
+            Access::Rwr => "rwr",
+            Access::Rww => "rww",
+            Access::Const => "const",
+        }
+    }
+
+    pub fn is_readable(self) -> bool {
+        !matches!(self, Access::Wo)
+    }
+
+    pub fn is_writable(self) -> bool {
+        matches!(self, Access::Wo | Access::Rw | Access::Rwr | Access::Rww)
+    }
+}
+
+/// One value-carrying entry (a VAR, or a sub-entry of an ARRAY/RECORD).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Entry {
+    pub subindex: u8,
+    pub name: String,
+    pub data_type: DataType,
+    pub access: Access,
+    pub pdo_mappable: bool,
+    pub default: Option<Literal>,
+    pub low_limit: Option<Literal>,
+    pub high_limit: Option<Literal>,
+    /// DCF `ParameterValue`: the value configured for this node.
+    pub parameter_value: Option<Literal>,
+    pub obj_flags: Option<u32>,
+    pub denotation: Option<String>,
+    pub origin: Origin,
+}
+
+impl Entry {
+    /// True when the default value is a `$NODEID` formula.
+    pub fn node_relative(&self) -> bool {
+        self.default.as_ref().is_some_and(|l| l.plus_node_id)
+    }
+}
