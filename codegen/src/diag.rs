@@ -197,7 +197,6 @@ impl Diagnostics {
                 buf = format!("{d}\n");
             }
             out.push_str(&buf);
-            out.push('\n');
         }
         out
     }

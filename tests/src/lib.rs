@@ -1,1 +1,46 @@
-//! Shared helpers of the cross-crate tests.
+//! Shared helpers of eds2rust's cross-crate tests: where the workspace, the
+//! shared corpus and the python-canopen oracle are.
+
+pub mod python;
+
+use std::path::{Path, PathBuf};
+
+/// The workspace root.
+pub fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("tests/ has a parent")
+        .to_path_buf()
+}
+
+/// The directory `../shared` beside the workspace, when it is there.
+pub fn shared_dir() -> Option<PathBuf> {
+    let dir = workspace_root().join("..").join("shared");
+    dir.is_dir().then_some(dir)
+}
+
+/// Every file of `../shared/eds-corpus/files`, sorted; `None` (after printing
+/// one line that names what did not run) when `../shared` is absent.
+pub fn corpus_files(what: &str) -> Option<Vec<PathBuf>> {
+    let Some(shared) = shared_dir() else {
+        eprintln!("NOT RUN: {what}: ../shared/eds-corpus is not beside this checkout");
+        return None;
+    };
+    let dir = shared.join("eds-corpus").join("files");
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
+        .map(|e| e.expect("directory entry").path())
+        .filter(|p| p.is_file())
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "{} holds no files", dir.display());
+    Some(files)
+}
+
+/// The target directory cargo uses for this workspace.
+pub fn target_dir() -> PathBuf {
+    match std::env::var_os("CARGO_TARGET_DIR") {
+        Some(dir) => PathBuf::from(dir),
+        None => workspace_root().join("target"),
+    }
+}

@@ -8,6 +8,7 @@ mod entry;
 pub mod ini;
 mod lower;
 pub mod number;
+mod object;
 mod sections;
 
 use std::path::Path;

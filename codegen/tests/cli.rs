@@ -1,0 +1,149 @@
+//! The `eds2rust` binary: exit codes of `check`, and the `dump --format json`
+//! schema on the repository's example file.
+
+use std::process::Command;
+
+use serde_json::Value;
+
+const BIN: &str = env!("CARGO_BIN_EXE_eds2rust");
+
+fn example() -> String {
+    format!("{}/../eds/example.eds", env!("CARGO_MANIFEST_DIR"))
+}
+
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(BIN).args(args).output().expect("run eds2rust");
+    (
+        out.status.code().expect("exit code"),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+#[test]
+fn check_exit_codes() {
+    let (code, stdout, _) = run(&["check", &example()]);
+    assert_eq!(code, 0, "{stdout}");
+    assert!(stdout.contains("0 errors, 0 warnings"), "{stdout}");
+
+    let dir = tempdir();
+    let bad = dir.join("bad.eds");
+    std::fs::write(&bad, "[1000]\nParameterName=Device type\nObjectType=0x3\n").unwrap();
+    let (code, stdout, _) = run(&["check", bad.to_str().unwrap()]);
+    assert_eq!(code, 1, "{stdout}");
+    assert!(stdout.contains("eds::bad-object-type"), "{stdout}");
+    assert!(
+        stdout.contains("bad.eds:3:"),
+        "names file and line: {stdout}"
+    );
+
+    // A warning only: 0 in lenient mode, 1 with --strict.
+    let warn = dir.join("warn.eds");
+    std::fs::write(&warn, "[1000]\nParameterName=Device type\nDataType=0x0007\nAccessType=ro\nDefaultValue=017\nDefaultValue=0x10\n").unwrap();
+    assert_eq!(run(&["check", warn.to_str().unwrap()]).0, 0);
+    assert_eq!(run(&["check", "--strict", warn.to_str().unwrap()]).0, 1);
+
+    assert_eq!(run(&["check"]).0, 2, "no file is a usage error");
+    assert_eq!(run(&["dump", "--format", "yaml", &example()]).0, 2);
+    assert_eq!(run(&["dump", "--node-id", "200", &example()]).0, 2);
+    assert_eq!(
+        run(&["check", dir.join("missing.eds").to_str().unwrap()]).0,
+        1
+    );
+}
+
+fn tempdir() -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("eds2rust-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn entry<'a>(doc: &'a Value, index: u64, sub: u64) -> &'a Value {
+    doc["entries"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["index"] == index && e["subindex"] == sub)
+        .unwrap_or_else(|| panic!("entry {index:#x} sub {sub}"))
+}
+
+#[test]
+fn dump_json_schema_and_node_id() {
+    let (code, stdout, stderr) = run(&["dump", "--format", "json", "--node-id", "5", &example()]);
+    assert_eq!(code, 0, "{stderr}");
+    let doc: Value = serde_json::from_str(&stdout).unwrap();
+    let keys: Vec<&str> = doc
+        .as_object()
+        .unwrap()
+        .keys()
+        .map(String::as_str)
+        .collect();
+    assert_eq!(keys, ["file", "device", "entries", "diagnostics"]);
+    assert_eq!(doc["device"]["vendor_number"], 0xE2D);
+    assert_eq!(doc["device"]["product_name"], "Example Drive");
+    let e = entry(&doc, 0x1400, 1);
+    let keys: Vec<&str> = e.as_object().unwrap().keys().map(String::as_str).collect();
+    assert_eq!(
+        keys,
+        [
+            "index",
+            "subindex",
+            "object_type",
+            "parent_name",
+            "name",
+            "data_type",
+            "access",
+            "pdo_mappable",
+            "default",
+            "low_limit",
+            "high_limit",
+            "parameter_value",
+            "node_relative"
+        ]
+    );
+    assert_eq!(e["default"], 0x205);
+    assert_eq!(e["node_relative"], true);
+    assert_eq!(e["object_type"], "RECORD");
+    assert_eq!(e["parent_name"], "RPDO1 communication parameter");
+    assert_eq!(
+        entry(&doc, 0x1800, 1)["default"],
+        0x185,
+        "`0x180 + $NODEID` with spaces"
+    );
+    // CompactSubObj: sub 0 and two named subs.
+    assert_eq!(entry(&doc, 0x1016, 0)["default"], 2);
+    assert_eq!(
+        entry(&doc, 0x1016, 2)["name"],
+        "Heartbeat of the safety controller"
+    );
+    assert_eq!(entry(&doc, 0x1016, 2)["access"], "rw");
+    // REAL32 from a hex bit pattern and decimals.
+    let gear = entry(&doc, 0x2000, 0);
+    assert_eq!(
+        (gear["default"].as_f64(), gear["low_limit"].as_f64()),
+        (Some(12.5), Some(1.0))
+    );
+    assert_eq!(entry(&doc, 0x6060, 0)["low_limit"], -4);
+    assert_eq!(entry(&doc, 0x1F50, 0)["object_type"], "DOMAIN");
+    assert_eq!(entry(&doc, 0x1F50, 0)["default"], Value::Null);
+    // Sorted by index then subindex.
+    let order: Vec<(u64, u64)> = doc["entries"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|e| {
+            (
+                e["index"].as_u64().unwrap(),
+                e["subindex"].as_u64().unwrap(),
+            )
+        })
+        .collect();
+    let mut sorted = order.clone();
+    sorted.sort();
+    assert_eq!(order, sorted);
+
+    // Without --node-id the formula stays unresolved.
+    let (_, stdout, _) = run(&["dump", "--format", "json", &example()]);
+    let doc: Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(entry(&doc, 0x1400, 1)["default"], 0x200);
+}

@@ -1,0 +1,98 @@
+//! The python-canopen oracle: a virtual environment that the tests create by
+//! themselves on first use, under the target directory, with the pinned
+//! packages of `tests/python/requirements.txt`.
+//!
+//! Creation is guarded by a file lock, so parallel test processes share one
+//! environment. Any failure is an error with the reason: tests that need the
+//! oracle fail, they never skip.
+
+use std::fs::{self, File};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::{target_dir, workspace_root};
+
+/// The directory of the oracle's scripts (`tests/python`).
+pub fn scripts_dir() -> PathBuf {
+    workspace_root().join("tests").join("python")
+}
+
+/// Path of the environment's Python interpreter, creating the environment when
+/// it is missing or its requirements changed.
+pub fn python() -> Result<PathBuf, String> {
+    let requirements_path = scripts_dir().join("requirements.txt");
+    let requirements = fs::read_to_string(&requirements_path)
+        .map_err(|e| format!("cannot read {}: {e}", requirements_path.display()))?;
+    let target = target_dir();
+    fs::create_dir_all(&target).map_err(|e| format!("cannot create {}: {e}", target.display()))?;
+    let venv = target.join("pyoracle");
+    let lock_path = target.join("pyoracle.lock");
+    let lock = File::create(&lock_path)
+        .map_err(|e| format!("cannot create {}: {e}", lock_path.display()))?;
+    lock.lock()
+        .map_err(|e| format!("cannot lock {}: {e}", lock_path.display()))?;
+    let stamp = venv.join("requirements.installed");
+    let interpreter = venv.join("bin").join("python");
+    if fs::read_to_string(&stamp).ok().as_deref() == Some(requirements.as_str())
+        && interpreter.exists()
+    {
+        return Ok(interpreter);
+    }
+    let _ = fs::remove_dir_all(&venv);
+    let system_python = std::env::var("PYTHON").unwrap_or_else(|_| "python3".to_string());
+    run(
+        Command::new(&system_python).args(["-m", "venv"]).arg(&venv),
+        "create the python-canopen venv",
+    )?;
+    run(
+        Command::new(&interpreter)
+            .args([
+                "-m",
+                "pip",
+                "install",
+                "--quiet",
+                "--disable-pip-version-check",
+                "-r",
+            ])
+            .arg(&requirements_path),
+        "install the pinned python-canopen packages",
+    )?;
+    fs::write(&stamp, &requirements)
+        .map_err(|e| format!("cannot write {}: {e}", stamp.display()))?;
+    Ok(interpreter)
+}
+
+fn run(command: &mut Command, what: &str) -> Result<(), String> {
+    let output = command
+        .output()
+        .map_err(|e| format!("cannot {what}: {e} (is python3 with venv installed?)"))?;
+    if output.status.success() {
+        Ok(())
+    } else {
+        Err(format!(
+            "cannot {what}: {}\n{}{}",
+            output.status,
+            String::from_utf8_lossy(&output.stdout),
+            String::from_utf8_lossy(&output.stderr)
+        ))
+    }
+}
+
+/// Runs a script of `tests/python` with the oracle's interpreter and returns its stdout.
+pub fn run_script(script: &str, args: &[&Path], extra: &[&str]) -> Result<String, String> {
+    let python = python()?;
+    let output = Command::new(python)
+        .arg(scripts_dir().join(script))
+        .args(extra)
+        .args(args)
+        .output()
+        .map_err(|e| format!("cannot run {script}: {e}"))?;
+    if !output.status.success() {
+        return Err(format!(
+            "{script} failed: {}\n{}",
+            output.status,
+            String::from_utf8_lossy(&output.stderr)
+        ));
+    }
+    String::from_utf8(output.stdout).map_err(|e| format!("{script} printed non-UTF-8: {e}"))
+}
