@@ -43,7 +43,7 @@ fn check_mapping_entry(
             "DefaultValue"
         };
         // Point at the value when the entry's section has it, else at the section.
-        let section = doc.sections.iter().find(|s| s.line == entry.origin.line);
+        let section = doc.section_at_line(entry.origin.line);
         let prop = section.and_then(|s| s.get(key));
         diags.push(Diagnostic {
             severity: Severity::Warning,
@@ -54,8 +54,8 @@ fn check_mapping_entry(
                 span: prop
                     .map(|p| p.value_span.clone())
                     .or_else(|| section.map(|s| s.header_span.clone())),
-                section: section.map(|s| s.name.clone()),
-                key: prop.map(|p| p.key.clone()),
+                section: section.map(|s| s.name.to_string()),
+                key: prop.map(|p| p.key.to_string()),
             },
             message,
             notes: Vec::new(),

@@ -3,7 +3,7 @@
 use super::ini::{Property, Section};
 use super::lower::Lowering;
 use super::number::{self, parse_value};
-use crate::ir::{Access, DataType, Entry, Literal, ObjectKind, Origin, Value};
+use crate::ir::{Access, DataType, Entry, Literal, ObjectKind, Origin, Value, ValueKind};
 
 impl Lowering<'_> {
     /// Reads one entry. `kind` is the object's kind for a VAR/DOMAIN/DEFTYPE
@@ -21,7 +21,7 @@ impl Lowering<'_> {
             format!("Sub-index {sub}")
         };
         let name = match section.get("ParameterName").filter(|p| !p.value.is_empty()) {
-            Some(p) => p.value.clone(),
+            Some(p) => p.value.to_string(),
             None => {
                 self.report(
                     crate::diag::Severity::Warning,
@@ -125,7 +125,15 @@ impl Lowering<'_> {
             },
         };
         let value = |this: &mut Self, key: &str| -> Option<Literal> {
-            let p = section.get(key).filter(|p| !p.value.is_empty())?;
+            // An empty value is absent, except for strings and byte strings,
+            // where it is the empty value.
+            let text_like = matches!(
+                data_type.value_kind(),
+                Some(ValueKind::Text | ValueKind::Bytes)
+            ) && !key.ends_with("Limit");
+            let p = section
+                .get(key)
+                .filter(|p| text_like || !p.value.is_empty())?;
             this.literal(section, p, data_type)
         };
         let default = value(self, "DefaultValue");
@@ -153,7 +161,7 @@ impl Lowering<'_> {
         };
         let denotation = section
             .get("Denotation")
-            .map(|p| p.value.clone())
+            .map(|p| p.value.to_string())
             .filter(|v| !v.is_empty());
         let entry = Entry {
             subindex: sub,
@@ -200,15 +208,15 @@ impl Lowering<'_> {
                         return Some(Literal {
                             value: Value::Integer(v),
                             plus_node_id: rel,
-                            text: p.value.clone(),
+                            text: p.value.to_string(),
                         });
                     }
-                    Err(_) => Value::Text(p.value.clone()),
+                    Err(_) => Value::Text(p.value.to_string()),
                 };
                 Some(Literal {
                     value,
                     plus_node_id: false,
-                    text: p.value.clone(),
+                    text: p.value.to_string(),
                 })
             }
             Some(Ok(parsed)) => {

@@ -21,11 +21,11 @@ use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
 
 /// A `key=value` line.
 #[derive(Debug, Clone)]
-pub struct Property {
+pub struct Property<'a> {
     /// The key as written.
-    pub key: String,
+    pub key: &'a str,
     /// The value, trimmed, with any inline comment removed.
-    pub value: String,
+    pub value: &'a str,
     pub line: u32,
     /// Byte range of the value in the decoded text (of the key when the value is empty).
     pub value_span: Range<usize>,
@@ -35,17 +35,17 @@ pub struct Property {
 
 /// One `[section]` with its properties.
 #[derive(Debug, Clone)]
-pub struct Section {
+pub struct Section<'a> {
     /// The name as written, without brackets.
-    pub name: String,
+    pub name: &'a str,
     pub line: u32,
     pub header_span: Range<usize>,
-    pub properties: Vec<Property>,
+    pub properties: Vec<Property<'a>>,
 }
 
-impl Section {
+impl<'a> Section<'a> {
     /// The property whose key matches `key` without regard to case.
-    pub fn get(&self, key: &str) -> Option<&Property> {
+    pub fn get(&self, key: &str) -> Option<&Property<'a>> {
         self.properties
             .iter()
             .find(|p| p.key.eq_ignore_ascii_case(key))
@@ -54,16 +54,22 @@ impl Section {
 
 /// A parsed INI document.
 #[derive(Debug, Clone)]
-pub struct Document {
+pub struct Document<'a> {
     pub file: String,
-    pub text: String,
-    pub sections: Vec<Section>,
+    pub text: &'a str,
+    pub sections: Vec<Section<'a>>,
     by_name: HashMap<String, usize>,
 }
 
-impl Document {
+impl<'a> Document<'a> {
+    /// The section whose header is on `line` (sections are in file order).
+    pub fn section_at_line(&self, line: u32) -> Option<&Section<'a>> {
+        let i = self.sections.partition_point(|s| s.line < line);
+        self.sections.get(i).filter(|s| s.line == line)
+    }
+
     /// The section whose name matches `name` without regard to case.
-    pub fn section(&self, name: &str) -> Option<&Section> {
+    pub fn section(&self, name: &str) -> Option<&Section<'a>> {
         self.by_name
             .get(&name.to_ascii_lowercase())
             .map(|&i| &self.sections[i])
@@ -85,8 +91,8 @@ fn is_free_text_key(key: &str) -> bool {
         "nodename",
         "networkname",
     ];
-    let lower = key.to_ascii_lowercase();
-    KEYS.contains(&lower.as_str()) || lower.starts_with("line")
+    KEYS.iter().any(|k| k.eq_ignore_ascii_case(key))
+        || key.get(..4).is_some_and(|p| p.eq_ignore_ascii_case("line"))
 }
 
 /// Decodes the bytes of a file: UTF-8, else Windows-1252 with a warning.
@@ -132,8 +138,8 @@ fn line_start(text: &str, line: u32) -> usize {
 }
 
 /// Splits decoded text into sections. Problems of the INI layer are pushed to `diags`.
-pub fn parse(file: &str, text: String, diags: &mut Diagnostics) -> Document {
-    let mut sections: Vec<Section> = Vec::new();
+pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document<'a> {
+    let mut sections: Vec<Section<'a>> = Vec::new();
     let mut by_name: HashMap<String, usize> = HashMap::new();
     // Index into `sections` of the section that receives properties now.
     let mut current: Option<usize> = None;
@@ -185,7 +191,7 @@ pub fn parse(file: &str, text: String, diags: &mut Diagnostics) -> Document {
                 current = None;
                 continue;
             };
-            let name = rest[..close].trim().to_string();
+            let name = rest[..close].trim();
             let after = rest[close + 1..].trim();
             if !after.is_empty() && !after.starts_with(';') && !after.starts_with('#') {
                 warn(
@@ -237,27 +243,26 @@ pub fn parse(file: &str, text: String, diags: &mut Diagnostics) -> Document {
             );
             continue;
         };
-        let section_name = sections[section_index].name.clone();
         let Some(eq) = trimmed.find('=') else {
             warn(
                 diags,
                 "eds::not-key-value",
                 line_no,
                 line_span,
-                Some(&section_name),
+                Some(&sections[section_index].name),
                 None,
                 "a line without `=` is ignored".to_string(),
             );
             continue;
         };
-        let key = trimmed[..eq].trim().to_string();
+        let key = trimmed[..eq].trim();
         if key.is_empty() {
             warn(
                 diags,
                 "eds::not-key-value",
                 line_no,
                 line_span,
-                Some(&section_name),
+                Some(&sections[section_index].name),
                 None,
                 "a line with an empty key is ignored".to_string(),
             );
@@ -266,7 +271,7 @@ pub fn parse(file: &str, text: String, diags: &mut Diagnostics) -> Document {
         let raw_value = &trimmed[eq + 1..];
         let value_lead = raw_value.len() - raw_value.trim_start().len();
         let mut value = raw_value.trim();
-        if !is_free_text_key(&key) {
+        if !is_free_text_key(key) {
             value = strip_inline_comment(value);
         }
         let value_start = line_span.start + eq + 1 + value_lead;
@@ -276,27 +281,31 @@ pub fn parse(file: &str, text: String, diags: &mut Diagnostics) -> Document {
             value_start..value_start + value.len()
         };
         let property = Property {
-            key: key.clone(),
-            value: value.to_string(),
+            key,
+            value,
             line: line_no,
             value_span,
             line_span: line_span.clone(),
         };
-        let props = &mut sections[section_index].properties;
-        if let Some(pos) = props.iter().position(|p| p.key.eq_ignore_ascii_case(&key)) {
-            let first_line = props[pos].line;
-            props[pos] = property;
+        let section = &mut sections[section_index];
+        if let Some(pos) = section
+            .properties
+            .iter()
+            .position(|p| p.key.eq_ignore_ascii_case(key))
+        {
+            let first_line = section.properties[pos].line;
+            section.properties[pos] = property;
             warn(
                 diags,
                 "eds::duplicate-key",
                 line_no,
                 line_span,
-                Some(&section_name),
-                Some(&key),
+                Some(&section.name),
+                Some(key),
                 format!("key repeated (first at line {first_line}); this later value wins"),
             );
         } else {
-            props.push(property);
+            section.properties.push(property);
         }
     }
     Document {
@@ -322,9 +331,9 @@ fn strip_inline_comment(value: &str) -> &str {
 mod tests {
     use super::*;
 
-    fn doc(text: &str) -> (Document, Diagnostics) {
+    fn doc(text: &str) -> (Document<'_>, Diagnostics) {
         let mut d = Diagnostics::new();
-        let doc = parse("t.eds", text.to_string(), &mut d);
+        let doc = parse("t.eds", text, &mut d);
         (doc, d)
     }
 

@@ -17,7 +17,7 @@ use crate::ir::{
 };
 
 pub(super) struct Lowering<'a> {
-    pub doc: &'a Document,
+    pub doc: &'a Document<'a>,
     pub diags: &'a mut Diagnostics,
 }
 
@@ -34,13 +34,13 @@ impl<'a> Lowering<'a> {
             Some(p) => Location {
                 line: Some(p.line),
                 span: Some(p.value_span.clone()),
-                section: Some(section.name.clone()),
-                key: Some(p.key.clone()),
+                section: Some(section.name.to_string()),
+                key: Some(p.key.to_string()),
             },
             None => Location {
                 line: Some(section.line),
                 span: Some(section.header_span.clone()),
-                section: Some(section.name.clone()),
+                section: Some(section.name.to_string()),
                 key: None,
             },
         };
@@ -85,7 +85,7 @@ impl<'a> Lowering<'a> {
     pub(super) fn text(section: Option<&Section>, key: &str) -> Option<String> {
         section?
             .get(key)
-            .map(|p| p.value.clone())
+            .map(|p| p.value.to_string())
             .filter(|v| !v.is_empty())
     }
 
@@ -205,7 +205,7 @@ impl<'a> Lowering<'a> {
                 .properties
                 .iter()
                 .filter(|p| p.key.to_ascii_lowercase().starts_with("line"))
-                .map(|p| p.value.clone())
+                .map(|p| p.value.to_string())
                 .collect(),
             None => Vec::new(),
         };
@@ -225,7 +225,7 @@ impl<'a> Lowering<'a> {
     }
 
     /// Reads the object lists: index → (list section, property).
-    fn object_lists(&mut self) -> BTreeMap<u16, (&'a Section, &'a Property)> {
+    fn object_lists(&mut self) -> BTreeMap<u16, (&'a Section<'a>, &'a Property<'a>)> {
         let doc = self.doc;
         let mut listed = BTreeMap::new();
         for list in ["MandatoryObjects", "OptionalObjects", "ManufacturerObjects"] {

@@ -59,7 +59,7 @@ pub fn read_bytes(file: &str, bytes: &[u8], options: Options) -> Loaded {
     let mut diagnostics = Diagnostics::new();
     let text = ini::decode(file, bytes, &mut diagnostics);
     diagnostics.add_source(file, &text);
-    let doc = ini::parse(file, text, &mut diagnostics);
+    let doc = ini::parse(file, &text, &mut diagnostics);
     let device = lower::Lowering {
         doc: &doc,
         diags: &mut diagnostics,

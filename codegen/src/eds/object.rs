@@ -199,7 +199,7 @@ impl Lowering<'_> {
             let mut entry = template.clone();
             entry.subindex = sub;
             entry.name = match name_of(sub) {
-                Some(p) => p.value.clone(),
+                Some(p) => p.value.to_string(),
                 None => format!("{name}{sub}"),
             };
             if let Some(p) = name_of(sub) {
