@@ -89,7 +89,7 @@ fn check(files: &[PathBuf], options: Options) -> ExitCode {
     }
 }
 
-fn dump(path: &PathBuf, node_id: Option<u8>, options: Options) -> ExitCode {
+fn dump(path: &std::path::Path, node_id: Option<u8>, options: Options) -> ExitCode {
     let loaded = eds::read_file(path, options);
     let name = path.display().to_string();
     let json =

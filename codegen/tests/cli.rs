@@ -58,7 +58,7 @@ fn tempdir() -> std::path::PathBuf {
     dir
 }
 
-fn entry<'a>(doc: &'a Value, index: u64, sub: u64) -> &'a Value {
+fn entry(doc: &Value, index: u64, sub: u64) -> &Value {
     doc["entries"]
         .as_array()
         .unwrap()

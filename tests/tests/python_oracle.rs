@@ -181,14 +181,11 @@ fn explain(
     }
     if let (Some(ValueKind::Integer { signed: true, bits }), true) =
         (entry.data_type.value_kind(), hex)
+        && matches!(field, "default" | "parameter_value")
+        && let (Some(a), Some(b)) = (ours.as_i64(), theirs.as_i64())
+        && i128::from(b) - i128::from(a) == 1i128 << bits
     {
-        if matches!(field, "default" | "parameter_value") {
-            if let (Some(a), Some(b)) = (ours.as_i64(), theirs.as_i64()) {
-                if i128::from(b) - i128::from(a) == 1i128 << bits {
-                    return Some("signed-hex-default");
-                }
-            }
-        }
+        return Some("signed-hex-default");
     }
     None
 }

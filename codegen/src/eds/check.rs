@@ -107,13 +107,13 @@ fn check_mapping_entry(
         }
         _ => None,
     };
-    if let Some(expected) = expected {
-        if !expected.contains(&u32::from(bits)) {
-            warn(format!(
-                "maps 0x{target:04X} sub {sub} with {bits} bits, but its type {} has {} bits",
-                mapped.data_type.name(),
-                expected[expected.len() - 1]
-            ));
-        }
+    if let Some(expected) = expected
+        && !expected.contains(&u32::from(bits))
+    {
+        warn(format!(
+            "maps 0x{target:04X} sub {sub} with {bits} bits, but its type {} has {} bits",
+            mapped.data_type.name(),
+            expected[expected.len() - 1]
+        ));
     }
 }

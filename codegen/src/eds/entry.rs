@@ -45,7 +45,7 @@ impl Lowering<'_> {
                 );
                 return None;
             }
-            Some(p) => match number::parse_int(&p.value)
+            Some(p) => match number::parse_int(p.value)
                 .ok()
                 .and_then(|v| u16::try_from(v).ok())
             {
@@ -109,7 +109,7 @@ impl Lowering<'_> {
         };
         let pdo_mappable = match section.get("PDOMapping").filter(|p| !p.value.is_empty()) {
             None => false,
-            Some(p) => match number::parse_int(&p.value) {
+            Some(p) => match number::parse_int(p.value) {
                 Ok(0) => false,
                 Ok(1) => true,
                 _ => {
@@ -142,7 +142,7 @@ impl Lowering<'_> {
         let parameter_value = value(self, "ParameterValue");
         let obj_flags = match section.get("ObjFlags").filter(|p| !p.value.is_empty()) {
             None => None,
-            Some(p) => match number::parse_int(&p.value)
+            Some(p) => match number::parse_int(p.value)
                 .ok()
                 .and_then(|v| u32::try_from(v).ok())
             {
@@ -200,10 +200,10 @@ impl Lowering<'_> {
                 message,
             )
         };
-        match parse_value(&p.value, data_type) {
+        match parse_value(p.value, data_type) {
             None => {
                 // Unknown type: keep an integer when it reads as one, else the text.
-                let value = match number::parse_int_expr(&p.value) {
+                let value = match number::parse_int_expr(p.value) {
                     Ok((v, rel)) => {
                         return Some(Literal {
                             value: Value::Integer(v),
@@ -252,22 +252,22 @@ impl Lowering<'_> {
             num(&entry.high_limit),
             num(&entry.default),
         );
-        if let (Some(lo), Some(hi)) = (low, high) {
-            if lo > hi {
-                let p = section.get("LowLimit");
-                self.report(
-                    crate::diag::Severity::Warning,
-                    "eds::limits",
-                    section,
-                    p,
-                    format!(
-                        "LowLimit {} is above HighLimit {}",
-                        entry.low_limit.as_ref().map_or("", |l| &l.text),
-                        entry.high_limit.as_ref().map_or("", |l| &l.text)
-                    ),
-                );
-                return;
-            }
+        if let (Some(lo), Some(hi)) = (low, high)
+            && lo > hi
+        {
+            let p = section.get("LowLimit");
+            self.report(
+                crate::diag::Severity::Warning,
+                "eds::limits",
+                section,
+                p,
+                format!(
+                    "LowLimit {} is above HighLimit {}",
+                    entry.low_limit.as_ref().map_or("", |l| &l.text),
+                    entry.high_limit.as_ref().map_or("", |l| &l.text)
+                ),
+            );
+            return;
         }
         if let Some(d) = default {
             let below = low.is_some_and(|lo| d < lo);

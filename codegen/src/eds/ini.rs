@@ -199,7 +199,7 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                     "eds::bad-section-header",
                     line_no,
                     line_span.clone(),
-                    Some(&name),
+                    Some(name),
                     None,
                     format!("text after the section header is ignored: `{after}`"),
                 );
@@ -212,7 +212,7 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                     "eds::duplicate-section",
                     line_no,
                     line_span,
-                    Some(&name),
+                    Some(name),
                     None,
                     format!(
                         "section [{name}] appears again (first at line {first_line}); its keys are merged into the first, later keys win"
@@ -239,7 +239,7 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                 line_span,
                 None,
                 None,
-                "a line before the first section header is ignored".to_string(),
+                "a line outside any section (before the first header or after a broken one) is ignored".to_string(),
             );
             continue;
         };
@@ -249,7 +249,7 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                 "eds::not-key-value",
                 line_no,
                 line_span,
-                Some(&sections[section_index].name),
+                Some(sections[section_index].name),
                 None,
                 "a line without `=` is ignored".to_string(),
             );
@@ -262,7 +262,7 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                 "eds::not-key-value",
                 line_no,
                 line_span,
-                Some(&sections[section_index].name),
+                Some(sections[section_index].name),
                 None,
                 "a line with an empty key is ignored".to_string(),
             );
@@ -300,7 +300,7 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                 "eds::duplicate-key",
                 line_no,
                 line_span,
-                Some(&section.name),
+                Some(section.name),
                 Some(key),
                 format!("key repeated (first at line {first_line}); this later value wins"),
             );

@@ -96,7 +96,7 @@ impl<'a> Lowering<'a> {
         if prop.value.is_empty() {
             return None;
         }
-        match number::parse_int(&prop.value) {
+        match number::parse_int(prop.value) {
             Ok(v) => Some(v),
             Err(e) => {
                 self.warn(
@@ -238,7 +238,7 @@ impl<'a> Lowering<'a> {
                 if prop.key.eq_ignore_ascii_case("SupportedObjects") {
                     continue;
                 }
-                if number::parse_int(&prop.key).is_err() {
+                if number::parse_int(prop.key).is_err() {
                     self.warn(
                         "eds::object-list",
                         section,
@@ -248,23 +248,20 @@ impl<'a> Lowering<'a> {
                     continue;
                 }
                 count += 1;
-                match number::parse_int(&prop.value)
+                match number::parse_int(prop.value)
                     .ok()
                     .and_then(|v| u16::try_from(v).ok())
                 {
                     Some(index) => {
-                        if let Some((other, _)) = listed.insert(index, (section, prop)) {
-                            if other.name != section.name {
-                                self.warn(
-                                    "eds::object-list",
-                                    section,
-                                    Some(prop),
-                                    format!(
-                                        "object 0x{index:04X} is also listed in [{}]",
-                                        other.name
-                                    ),
-                                );
-                            }
+                        if let Some((other, _)) = listed.insert(index, (section, prop))
+                            && other.name != section.name
+                        {
+                            self.warn(
+                                "eds::object-list",
+                                section,
+                                Some(prop),
+                                format!("object 0x{index:04X} is also listed in [{}]", other.name),
+                            );
                         }
                     }
                     None => self.warn(
@@ -278,16 +275,16 @@ impl<'a> Lowering<'a> {
                     ),
                 }
             }
-            if let Some(declared) = declared {
-                if declared != count {
-                    let p = section.get("SupportedObjects");
-                    self.warn(
-                        "eds::object-list",
-                        section,
-                        p,
-                        format!("SupportedObjects says {declared} but the section lists {count}"),
-                    );
-                }
+            if let Some(declared) = declared
+                && declared != count
+            {
+                let p = section.get("SupportedObjects");
+                self.warn(
+                    "eds::object-list",
+                    section,
+                    p,
+                    format!("SupportedObjects says {declared} but the section lists {count}"),
+                );
             }
         }
         listed
@@ -301,7 +298,7 @@ impl<'a> Lowering<'a> {
         let mut names: BTreeMap<u16, &Section> = BTreeMap::new();
         let mut values: BTreeMap<u16, &Section> = BTreeMap::new();
         for section in &doc.sections {
-            match classify(&section.name) {
+            match classify(section.name) {
                 SectionKind::Object(i) => {
                     object_sections.insert(i, section);
                 }

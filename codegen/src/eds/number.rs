@@ -91,7 +91,7 @@ pub fn parse_hex_bytes(text: &str) -> Result<Vec<u8>, LiteralError> {
         .strip_prefix("0x")
         .or_else(|| digits.strip_prefix("0X"))
         .unwrap_or(&digits);
-    if digits.len() % 2 != 0 || !digits.bytes().all(|b| b.is_ascii_hexdigit()) {
+    if !digits.len().is_multiple_of(2) || !digits.bytes().all(|b| b.is_ascii_hexdigit()) {
         return Err(LiteralError(format!(
             "`{text}` is not a string of hex bytes"
         )));
@@ -145,7 +145,7 @@ pub fn parse_value(text: &str, data_type: DataType) -> Option<Result<Parsed, Lit
         text: text.to_string(),
     };
     Some(match kind {
-        ValueKind::Integer { signed, bits } => parse_int_expr(text).and_then(|(v, rel)| {
+        ValueKind::Integer { signed, bits } => parse_int_expr(text).map(|(v, rel)| {
             let (lo, hi) = data_type.integer_range().expect("integer type has a range");
             let mut warning = None;
             let mut v = v;
@@ -166,10 +166,10 @@ pub fn parse_value(text: &str, data_type: DataType) -> Option<Result<Parsed, Lit
                     ));
                 }
             }
-            Ok(Parsed {
+            Parsed {
                 literal: literal(Value::Integer(v), rel),
                 warning,
-            })
+            }
         }),
         ValueKind::Real { bits } => parse_real(text, bits).map(|v| Parsed {
             literal: literal(Value::Real(v), false),

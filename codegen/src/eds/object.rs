@@ -20,7 +20,7 @@ impl Lowering<'_> {
         let name = self.name(section, format!("Object 0x{index:04X}"));
         let kind = match section.get("ObjectType") {
             None => ObjectKind::Var,
-            Some(p) => match number::parse_int(&p.value) {
+            Some(p) => match number::parse_int(p.value) {
                 Ok(0x2) => ObjectKind::Domain,
                 Ok(0x5) => ObjectKind::DefType,
                 Ok(0x6) => ObjectKind::DefStruct,
@@ -61,7 +61,7 @@ impl Lowering<'_> {
                     "CompactSubObj on an object that has no sub-objects is ignored".into(),
                 );
             }
-            for (_, sub) in &subs {
+            for sub in subs.values() {
                 self.warn("eds::orphan-sub", sub, None, format!("object 0x{index:04X} is a {kind:?}, which has no sub-objects; the section is ignored"));
             }
             if let Some(entry) = self.entry(index, 0, section, kind) {
@@ -71,7 +71,7 @@ impl Lowering<'_> {
             if let Some(n) = compact {
                 if let Some(p) = section
                     .get("SubNumber")
-                    .filter(|p| number::parse_int(&p.value).is_ok_and(|v| v != 0))
+                    .filter(|p| number::parse_int(p.value).is_ok_and(|v| v != 0))
                 {
                     self.warn(
                         "eds::compact-sub-obj",
@@ -96,19 +96,19 @@ impl Lowering<'_> {
             }
             let declared: Option<u16> = self.uint(Some(section), "SubNumber");
             if compact.is_none() {
-                if let Some(declared) = declared {
-                    if usize::from(declared) != subs.len() {
-                        let p = section.get("SubNumber");
-                        self.warn(
-                            "eds::sub-number",
-                            section,
-                            p,
-                            format!(
-                                "SubNumber says {declared} but {} sub-object sections were found",
-                                subs.len()
-                            ),
-                        );
-                    }
+                if let Some(declared) = declared
+                    && usize::from(declared) != subs.len()
+                {
+                    let p = section.get("SubNumber");
+                    self.warn(
+                        "eds::sub-number",
+                        section,
+                        p,
+                        format!(
+                            "SubNumber says {declared} but {} sub-object sections were found",
+                            subs.len()
+                        ),
+                    );
                 }
                 if subs.is_empty() {
                     self.warn(

@@ -48,20 +48,21 @@ pub fn classify(name: &str) -> SectionKind {
     if let Some(index) = hex4(&lower) {
         return SectionKind::Object(index);
     }
-    if lower.len() > 4 && lower.is_char_boundary(4) {
-        if let Some(index) = hex4(&lower[..4]) {
-            let rest = &lower[4..];
-            if let Some(sub) = rest.strip_prefix("sub") {
-                if !sub.is_empty() && sub.len() <= 2 && sub.bytes().all(|b| b.is_ascii_hexdigit()) {
-                    return SectionKind::Sub(index, u8::from_str_radix(sub, 16).unwrap_or(0));
-                }
-                return SectionKind::Unknown;
+    if lower.len() > 4
+        && lower.is_char_boundary(4)
+        && let Some(index) = hex4(&lower[..4])
+    {
+        let rest = &lower[4..];
+        if let Some(sub) = rest.strip_prefix("sub") {
+            if !sub.is_empty() && sub.len() <= 2 && sub.bytes().all(|b| b.is_ascii_hexdigit()) {
+                return SectionKind::Sub(index, u8::from_str_radix(sub, 16).unwrap_or(0));
             }
-            match rest {
-                "name" => return SectionKind::CompactNames(index),
-                "value" => return SectionKind::CompactValues(index),
-                _ => {}
-            }
+            return SectionKind::Unknown;
+        }
+        match rest {
+            "name" => return SectionKind::CompactNames(index),
+            "value" => return SectionKind::CompactValues(index),
+            _ => {}
         }
     }
     let is_tool = lower
