@@ -20,9 +20,19 @@ fn eds2rust_pass(files: &[PathBuf]) -> usize {
     entries
 }
 
-fn median(mut samples: Vec<f64>) -> f64 {
+/// Median seconds of `passes` passes over `files` (after one warm-up pass),
+/// and the number of entries one pass read.
+fn time_passes(files: &[PathBuf], passes: usize) -> (f64, usize) {
+    let entries = black_box(eds2rust_pass(files));
+    let mut samples: Vec<f64> = (0..passes)
+        .map(|_| {
+            let start = Instant::now();
+            black_box(eds2rust_pass(files));
+            start.elapsed().as_secs_f64()
+        })
+        .collect();
     samples.sort_by(|a, b| a.total_cmp(b));
-    samples[samples.len() / 2]
+    (samples[samples.len() / 2], entries)
 }
 
 fn main() {
@@ -32,15 +42,7 @@ fn main() {
         return;
     };
     let passes = if quick { 1 } else { 50 };
-    black_box(eds2rust_pass(&files)); // warm-up
-    let mut samples = Vec::with_capacity(passes);
-    let mut entries = 0;
-    for _ in 0..passes {
-        let start = Instant::now();
-        entries = black_box(eds2rust_pass(&files));
-        samples.push(start.elapsed().as_secs_f64());
-    }
-    let ours = median(samples);
+    let (ours, entries) = time_passes(&files, passes);
     println!(
         "eds2rust:       {} files, {entries} entries, {:.3} ms per pass (median of {passes})",
         files.len(),
@@ -79,13 +81,7 @@ fn main() {
         .filter(|p| !skipped.contains(&p.to_str().unwrap()))
         .cloned()
         .collect();
-    let mut samples = Vec::with_capacity(passes);
-    for _ in 0..passes {
-        let start = Instant::now();
-        black_box(eds2rust_pass(&common));
-        samples.push(start.elapsed().as_secs_f64());
-    }
-    let ours_common = median(samples);
+    let (ours_common, _) = time_passes(&common, passes);
     println!(
         "eds2rust:       the same {} files, {:.3} ms per pass (median of {passes})",
         common.len(),
