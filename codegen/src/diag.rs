@@ -155,7 +155,7 @@ impl Diagnostics {
         let ids: Vec<(String, usize)> = self
             .sources
             .iter()
-            .map(|(name, text)| (name.clone(), files.add(name.clone(), text.clone())))
+            .map(|(name, text)| (name.clone(), files.add(printable(name), printable(text))))
             .collect();
         let config = term::Config::default();
         let mut out = String::new();
@@ -172,9 +172,9 @@ impl Diagnostics {
                     };
                     CsDiagnostic::new(severity)
                         .with_code(d.code)
-                        .with_message(d.headline())
+                        .with_message(printable(&d.headline()))
                         .with_labels(vec![Label::primary(id, span.clone())])
-                        .with_notes(d.notes.clone())
+                        .with_notes(d.notes.iter().map(|n| printable(n)).collect())
                 }
                 _ => {
                     // No source position: a one-line rendering that still names the file.
@@ -182,7 +182,7 @@ impl Diagnostics {
                         "{}[{}]: {}\n",
                         d.severity.as_str(),
                         d.code,
-                        d.headline()
+                        printable(&d.headline())
                     ));
                     out.push_str(&format!("  = in {}\n", d.file));
                     for note in &d.notes {
@@ -202,6 +202,21 @@ impl Diagnostics {
     }
 }
 
+/// The text with every control character other than line breaks and tabs
+/// replaced by `?` (one per byte, so byte offsets into it stay valid): a
+/// hostile input must not send escape sequences to the user's terminal.
+fn printable(text: &str) -> String {
+    let mut out = String::with_capacity(text.len());
+    for c in text.chars() {
+        if c.is_control() && !matches!(c, '\n' | '\r' | '\t') {
+            out.extend(std::iter::repeat_n('?', c.len_utf8()));
+        } else {
+            out.push(c);
+        }
+    }
+    out
+}
+
 impl fmt::Display for Diagnostics {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(&self.render())
@@ -215,5 +230,37 @@ impl IntoIterator for Diagnostics {
     type IntoIter = std::vec::IntoIter<Diagnostic>;
     fn into_iter(self) -> Self::IntoIter {
         self.items.into_iter()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rendering_neutralises_control_characters() {
+        let text = "[1000]\nParameterName=a\u{1b}[2Jb\u{85}c\n";
+        let mut d = Diagnostics::new();
+        d.add_source("t.eds", text);
+        let start = text.find("ParameterName").unwrap();
+        d.push(Diagnostic {
+            severity: Severity::Warning,
+            code: "test",
+            file: "t.eds".into(),
+            location: Location {
+                line: Some(2),
+                span: Some(start..text.len() - 1),
+                section: None,
+                key: None,
+            },
+            message: "bad \u{7} bell".into(),
+            notes: vec![],
+        });
+        let out = d.render();
+        assert!(
+            !out.contains('\u{1b}') && !out.contains('\u{85}') && !out.contains('\u{7}'),
+            "{out}"
+        );
+        assert!(out.contains("a?[2Jb??c"), "{out}");
     }
 }
