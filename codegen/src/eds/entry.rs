@@ -3,6 +3,7 @@
 use super::ini::{Property, Section};
 use super::lower::Lowering;
 use super::number::{self, parse_value};
+use crate::diag::Severity;
 use crate::ir::{Access, DataType, Entry, Literal, ObjectKind, Origin, Value, ValueKind};
 
 impl Lowering<'_> {
@@ -24,7 +25,7 @@ impl Lowering<'_> {
             Some(p) => p.value.to_string(),
             None => {
                 self.report(
-                    crate::diag::Severity::Warning,
+                    Severity::Warning,
                     "eds::missing-name",
                     section,
                     None,
@@ -37,7 +38,7 @@ impl Lowering<'_> {
             None if kind == ObjectKind::Domain => DataType::Domain,
             None => {
                 self.report(
-                    crate::diag::Severity::Error,
+                    Severity::Error,
                     "eds::missing-data-type",
                     section,
                     None,
@@ -51,7 +52,7 @@ impl Lowering<'_> {
             {
                 None => {
                     self.report(
-                        crate::diag::Severity::Error,
+                        Severity::Error,
                         "eds::bad-data-type",
                         section,
                         Some(p),
@@ -70,7 +71,7 @@ impl Lowering<'_> {
                         } else {
                             ""
                         };
-                        self.report(crate::diag::Severity::Warning, "eds::unknown-data-type", section, Some(p), format!("data type {code:#06x}{note} is not a CiA 301 basic type (0x0001–0x001B); values of this entry are kept as text"));
+                        self.report(Severity::Warning, "eds::unknown-data-type", section, Some(p), format!("data type {code:#06x}{note} is not a CiA 301 basic type (0x0001–0x001B); values of this entry are kept as text"));
                     }
                     data_type
                 }
@@ -85,7 +86,7 @@ impl Lowering<'_> {
                 };
                 if kind != ObjectKind::DefType {
                     self.report(
-                        crate::diag::Severity::Warning,
+                        Severity::Warning,
                         "eds::missing-access",
                         section,
                         None,
@@ -102,7 +103,7 @@ impl Lowering<'_> {
                 "rww" => Access::Rww,
                 "const" => Access::Const,
                 _ => {
-                    self.report(crate::diag::Severity::Error, "eds::bad-access", section, Some(p), format!("`{}` is not an access type (ro, wo, rw, rwr, rww, const); read as `ro`", p.value));
+                    self.report(Severity::Error, "eds::bad-access", section, Some(p), format!("`{}` is not an access type (ro, wo, rw, rwr, rww, const); read as `ro`", p.value));
                     Access::Ro
                 }
             },
@@ -114,7 +115,7 @@ impl Lowering<'_> {
                 Ok(1) => true,
                 _ => {
                     self.report(
-                        crate::diag::Severity::Warning,
+                        Severity::Warning,
                         "eds::bad-pdo-mapping",
                         section,
                         Some(p),
@@ -149,7 +150,7 @@ impl Lowering<'_> {
                 Some(v) => Some(v),
                 None => {
                     self.report(
-                        crate::diag::Severity::Warning,
+                        Severity::Warning,
                         "eds::bad-number",
                         section,
                         Some(p),
@@ -192,13 +193,7 @@ impl Lowering<'_> {
         data_type: DataType,
     ) -> Option<Literal> {
         let warn = |this: &mut Self, code, message| {
-            this.report(
-                crate::diag::Severity::Warning,
-                code,
-                section,
-                Some(p),
-                message,
-            )
+            this.report(Severity::Warning, code, section, Some(p), message)
         };
         match parse_value(p.value, data_type) {
             None => {
@@ -257,7 +252,7 @@ impl Lowering<'_> {
         {
             let p = section.get("LowLimit");
             self.report(
-                crate::diag::Severity::Warning,
+                Severity::Warning,
                 "eds::limits",
                 section,
                 p,
@@ -280,7 +275,7 @@ impl Lowering<'_> {
                     "above HighLimit"
                 };
                 self.report(
-                    crate::diag::Severity::Warning,
+                    Severity::Warning,
                     "eds::limits",
                     section,
                     p,
