@@ -2,6 +2,8 @@
 //!
 //! Pipeline (one stage per module):
 //! - [`eds`]: EDS/DCF text (CiA 306) → [`ir::Device`], with diagnostics;
+//! - [`table`]: YAML object tables (whole devices and overlays on an EDS) → [`ir::Device`];
+//! - [`input`]: either of the two, chosen by file extension;
 //! - [`ir`]: the object-dictionary model, plain data;
 //! - [`dump`]: IR → JSON for tools and tests;
 //! - [`diag`]: diagnostics with file, line, section and key.
@@ -9,4 +11,6 @@
 pub mod diag;
 pub mod dump;
 pub mod eds;
+pub mod input;
 pub mod ir;
+pub mod table;

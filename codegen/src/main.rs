@@ -7,13 +7,13 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
-use eds2rust::eds::{self, Options};
+use eds2rust::input::{Options, read_device};
 
 #[derive(Parser)]
 #[command(
     name = "eds2rust",
     version,
-    about = "Reads CANopen object dictionaries (EDS/DCF) and reports on them"
+    about = "Reads CANopen object dictionaries (EDS/DCF files and YAML object tables) and reports on them"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -27,7 +27,7 @@ enum Command {
         /// Turn warnings into errors.
         #[arg(long)]
         strict: bool,
-        /// EDS or DCF files.
+        /// EDS/DCF files or YAML object tables (.yaml, .yml).
         #[arg(required = true)]
         files: Vec<PathBuf>,
     },
@@ -68,7 +68,7 @@ fn check(files: &[PathBuf], options: Options) -> ExitCode {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     for path in files {
-        let loaded = eds::read_file(path, options);
+        let loaded = read_device(path, options);
         let d = &loaded.diagnostics;
         let _ = write!(out, "{}", d.render());
         let objects = loaded.device.as_ref().map_or(0, |dev| dev.objects.len());
@@ -90,12 +90,13 @@ fn check(files: &[PathBuf], options: Options) -> ExitCode {
 }
 
 fn dump(path: &std::path::Path, node_id: Option<u8>, options: Options) -> ExitCode {
-    let loaded = eds::read_file(path, options);
+    let loaded = read_device(path, options);
     let name = path.display().to_string();
     let json =
         eds2rust::dump::json::to_json(&name, loaded.device.as_ref(), &loaded.diagnostics, node_id);
     let text = serde_json::to_string_pretty(&json).expect("a serde_json::Value always serialises");
-    println!("{text}");
+    // A closed pipe (`| head`) is not an error of ours.
+    let _ = writeln!(std::io::stdout().lock(), "{text}");
     if loaded.diagnostics.has_errors() {
         ExitCode::from(1)
     } else {

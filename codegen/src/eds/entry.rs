@@ -176,6 +176,7 @@ impl Lowering<'_> {
             parameter_value,
             obj_flags,
             denotation,
+            semantics: Default::default(),
             origin: Origin {
                 file: self.doc.file.clone(),
                 line: section.line,

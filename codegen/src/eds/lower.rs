@@ -13,7 +13,7 @@ use super::number;
 use super::sections::{SectionKind, classify};
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
 use crate::ir::{
-    Capabilities, Commissioning, DataType, Device, FileInfo, Identity, Object, Origin, Value,
+    Capabilities, Commissioning, DataType, Device, FileInfo, Identity, Object, Origin,
 };
 
 pub(super) struct Lowering<'a> {
@@ -219,8 +219,9 @@ impl<'a> Lowering<'a> {
             dummy_usage,
             objects,
             comments,
+            ..Device::default()
         };
-        fill_identity_from_1018(&mut device);
+        device.fill_identity_from_1018();
         device
     }
 
@@ -374,30 +375,5 @@ impl<'a> Lowering<'a> {
             );
         }
         objects
-    }
-}
-
-/// Where [DeviceInfo] lacks identity numbers, takes them from object 0x1018's defaults.
-fn fill_identity_from_1018(device: &mut Device) {
-    let from_1018 = |device: &Device, sub: u8| -> Option<u32> {
-        let entry = device.objects.get(&0x1018)?.entries.get(&sub)?;
-        match entry
-            .parameter_value
-            .as_ref()
-            .or(entry.default.as_ref())?
-            .value
-        {
-            Value::Integer(v) => u32::try_from(v).ok(),
-            _ => None,
-        }
-    };
-    if device.identity.vendor_number.is_none() {
-        device.identity.vendor_number = from_1018(device, 1);
-    }
-    if device.identity.product_number.is_none() {
-        device.identity.product_number = from_1018(device, 2);
-    }
-    if device.identity.revision_number.is_none() {
-        device.identity.revision_number = from_1018(device, 3);
     }
 }

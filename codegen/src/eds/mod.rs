@@ -14,22 +14,8 @@ mod sections;
 use std::path::Path;
 
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
-use crate::ir::Device;
 
-/// How strictly to read.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
-pub struct Options {
-    /// Turn every warning into an error.
-    pub strict: bool,
-}
-
-/// The result of reading one file: the device (absent only when the file could
-/// not be read at all) and every diagnostic.
-#[derive(Debug, Clone)]
-pub struct Loaded {
-    pub device: Option<Device>,
-    pub diagnostics: Diagnostics,
-}
+pub use crate::input::{Loaded, Options};
 
 /// Reads an EDS or DCF file from disk.
 pub fn read_file(path: &Path, options: Options) -> Loaded {

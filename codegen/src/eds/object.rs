@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use super::ini::Section;
 use super::lower::Lowering;
 use super::number;
-use crate::ir::{Access, DataType, Entry, Literal, Object, ObjectKind, Origin, Value};
+use crate::ir::{Entry, Object, ObjectKind, Origin};
 
 impl Lowering<'_> {
     pub(super) fn object(
@@ -166,27 +166,7 @@ impl Lowering<'_> {
     ) -> BTreeMap<u8, Entry> {
         let mut entries = BTreeMap::new();
         let origin = self.origin(section.line);
-        entries.insert(
-            0,
-            Entry {
-                subindex: 0,
-                name: "Highest sub-index supported".into(),
-                data_type: DataType::Unsigned8,
-                access: Access::Ro,
-                pdo_mappable: false,
-                default: Some(Literal {
-                    value: Value::Integer(n.into()),
-                    plus_node_id: false,
-                    text: n.to_string(),
-                }),
-                low_limit: None,
-                high_limit: None,
-                parameter_value: None,
-                obj_flags: None,
-                denotation: None,
-                origin,
-            },
-        );
+        entries.insert(0, Entry::highest_subindex(n, origin));
         let Some(template) = self.entry(index, 1, section, ObjectKind::Var) else {
             return entries;
         };

@@ -5,6 +5,8 @@
 //! the generators read from it. Every item carries its [`Origin`].
 
 mod datatype;
+pub mod pdo;
+mod semantics;
 mod value;
 
 use std::collections::BTreeMap;
@@ -12,17 +14,21 @@ use std::collections::BTreeMap;
 use serde::{Deserialize, Serialize};
 
 pub use datatype::{DataType, ValueKind};
+pub use semantics::{
+    BitField, EntryOverride, ErrorCode, ErrorTable, ErrorTableKind, Lss, LssService, NamedValue,
+    Network, Pattern, PdoDirection, PdoLabel, Semantics, ValueTable, Variant,
+};
 pub use value::{Literal, Value};
 
 /// Where an item came from: a file and a 1-based line.
-#[derive(Debug, Clone, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Origin {
     pub file: String,
     pub line: u32,
 }
 
 /// One device's object dictionary.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Device {
     /// Path of the main input file.
     pub source: String,
@@ -35,8 +41,48 @@ pub struct Device {
     pub dummy_usage: Vec<DataType>,
     /// Objects keyed by index, including DEFTYPE/DEFSTRUCT type definitions.
     pub objects: BTreeMap<u16, Object>,
-    /// Free text of the `[Comments]` section, line by line.
+    /// Free text of the `[Comments]` section, line by line (YAML: `notes`).
     pub comments: Vec<String>,
+    /// Network defaults and LSS facts (YAML only; a DCF's are in `commissioning`).
+    #[serde(default)]
+    pub network: Network,
+    /// Names of default PDOs (YAML only), sorted by direction and number.
+    #[serde(default)]
+    pub pdo_labels: Vec<PdoLabel>,
+    /// Device error tables (YAML only), sorted by name.
+    #[serde(default)]
+    pub error_tables: Vec<ErrorTable>,
+    /// Product variants (YAML only), in source order.
+    #[serde(default)]
+    pub variants: Vec<Variant>,
+}
+
+impl Device {
+    /// Where the identity lacks vendor, product or revision numbers, takes
+    /// them from object 0x1018 (its DCF value, else its default).
+    pub fn fill_identity_from_1018(&mut self) {
+        let from_1018 = |device: &Device, sub: u8| -> Option<u32> {
+            let entry = device.objects.get(&0x1018)?.entries.get(&sub)?;
+            match entry
+                .parameter_value
+                .as_ref()
+                .or(entry.default.as_ref())?
+                .value
+            {
+                Value::Integer(v) => u32::try_from(v).ok(),
+                _ => None,
+            }
+        };
+        if self.identity.vendor_number.is_none() {
+            self.identity.vendor_number = from_1018(self, 1);
+        }
+        if self.identity.product_number.is_none() {
+            self.identity.product_number = from_1018(self, 2);
+        }
+        if self.identity.revision_number.is_none() {
+            self.identity.revision_number = from_1018(self, 3);
+        }
+    }
 }
 
 /// File metadata (`[FileInfo]`), kept as written.
@@ -190,10 +236,37 @@ pub struct Entry {
     pub parameter_value: Option<Literal>,
     pub obj_flags: Option<u32>,
     pub denotation: Option<String>,
+    /// What the raw value means (YAML only).
+    #[serde(default, skip_serializing_if = "Semantics::is_empty")]
+    pub semantics: Semantics,
     pub origin: Origin,
 }
 
 impl Entry {
+    /// Sub-index 0 of an ARRAY or RECORD: "Highest sub-index supported",
+    /// UNSIGNED8, read-only, with `highest` as its default.
+    pub fn highest_subindex(highest: u8, origin: Origin) -> Entry {
+        Entry {
+            subindex: 0,
+            name: "Highest sub-index supported".into(),
+            data_type: DataType::Unsigned8,
+            access: Access::Ro,
+            pdo_mappable: false,
+            default: Some(Literal {
+                value: Value::Integer(highest.into()),
+                plus_node_id: false,
+                text: highest.to_string(),
+            }),
+            low_limit: None,
+            high_limit: None,
+            parameter_value: None,
+            obj_flags: None,
+            denotation: None,
+            semantics: Semantics::default(),
+            origin,
+        }
+    }
+
     /// True when the default value is a `$NODEID` formula.
     pub fn node_relative(&self) -> bool {
         self.default.as_ref().is_some_and(|l| l.plus_node_id)

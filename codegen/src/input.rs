@@ -1,0 +1,54 @@
+//! Reading a device from any input file: EDS/DCF or YAML object table,
+//! chosen by the file name's extension.
+
+use std::path::Path;
+
+use crate::diag::Diagnostics;
+use crate::ir::Device;
+
+/// How strictly to read.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Options {
+    /// Turn every warning into an error.
+    pub strict: bool,
+}
+
+/// The result of reading one file: the device (absent only when the file could
+/// not be read at all) and every diagnostic.
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    pub device: Option<Device>,
+    pub diagnostics: Diagnostics,
+}
+
+/// The kinds of input file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InputKind {
+    /// CiA 306 EDS or DCF.
+    Eds,
+    /// A YAML object table (`.yaml`, `.yml`).
+    Table,
+}
+
+impl InputKind {
+    /// The kind a path's extension says (anything but `.yaml`/`.yml` is EDS).
+    pub fn of(path: &Path) -> InputKind {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
+            Some("yaml" | "yml") => InputKind::Table,
+            _ => InputKind::Eds,
+        }
+    }
+}
+
+/// Reads an EDS/DCF file or a YAML object table from disk.
+pub fn read_device(path: &Path, options: Options) -> Loaded {
+    match InputKind::of(path) {
+        InputKind::Eds => crate::eds::read_file(path, options),
+        InputKind::Table => crate::table::read_file(path, options),
+    }
+}

@@ -1,0 +1,196 @@
+//! Lowers a parsed [`Table`] into an [`ir::Device`] in the documented order:
+//! base → delete → modify → add → semantics → PDO defaults → error tables,
+//! variants and the checks across the device.
+
+use std::path::Path;
+
+use serde_saphyr::Spanned;
+
+use super::schema::{DeviceDef, Table};
+use super::{At, Ctx};
+use crate::input::Options;
+use crate::ir::{Device, Identity};
+
+pub(super) fn lower(ctx: &mut Ctx, table: &Table, base_dir: &Path, options: Options) -> Device {
+    if table.format.value != 1 {
+        ctx.error(
+            "table::format",
+            At::of(&table.format),
+            "",
+            "format",
+            format!(
+                "format {} is not known; this reader reads format 1",
+                table.format.value
+            ),
+        );
+    }
+    let mut device = match &table.base {
+        Some(base) => read_base(ctx, base, base_dir, options),
+        None => whole_device_start(ctx, table),
+    };
+    if let Some(def) = &table.device {
+        apply_identity(ctx, &mut device.identity, def, true);
+        if let Some(description) = &def.value.description {
+            device.file_info.description = Some(description.value.clone());
+        }
+    }
+    if let Some(network) = &table.network {
+        super::extra::network(ctx, &mut device, network);
+    }
+    device
+        .comments
+        .extend(table.notes.iter().map(|n| n.value.clone()));
+
+    // 2. delete, 3. modify: only for overlays.
+    let overlay_only = [
+        ("delete", table.delete.first().map(At::of)),
+        ("modify", table.modify.first().map(At::of)),
+    ];
+    if table.base.is_none() {
+        for (key, at) in overlay_only {
+            if let Some(at) = at {
+                ctx.error(
+                    "table::overlay-only",
+                    at,
+                    "",
+                    key,
+                    format!("`{key}` changes a base EDS; this table has no `base:`"),
+                );
+            }
+        }
+    } else {
+        for def in &table.delete {
+            super::entry::delete(ctx, &mut device, def);
+        }
+        for def in &table.modify {
+            super::entry::modify(ctx, &mut device, def);
+        }
+    }
+    // 4. add (with inline semantics), 5. the semantics list.
+    for def in &table.objects {
+        super::entry::add(ctx, &mut device, def);
+    }
+    for def in &table.semantics {
+        super::meaning::apply_list_item(ctx, &mut device, def);
+    }
+    // 6. PDO defaults.
+    super::pdo::apply(ctx, &mut device, &table.pdos);
+    // 7. error tables, variants, checks across the device.
+    super::extra::error_tables(ctx, &mut device, &table.errors);
+    super::extra::variants(ctx, &mut device, &table.variants);
+    super::meaning::check_error_table_references(ctx, &device);
+    let written = super::pdo::written_mappings(&table.pdos);
+    super::pdo::check_mappings(ctx, &device, &written);
+    device.fill_identity_from_1018();
+    device
+}
+
+fn read_base(ctx: &mut Ctx, base: &Spanned<String>, base_dir: &Path, options: Options) -> Device {
+    let path = base_dir.join(&base.value);
+    let loaded = crate::eds::read_file(&path, options);
+    let failed = loaded.diagnostics.has_errors();
+    ctx.diags.extend(loaded.diagnostics);
+    match loaded.device {
+        Some(device) if !failed => device,
+        device => {
+            ctx.error(
+                "table::base",
+                At::of(base),
+                "",
+                "base",
+                format!(
+                    "the base EDS `{}` could not be read without errors (see above)",
+                    path.display()
+                ),
+            );
+            device.unwrap_or_default()
+        }
+    }
+}
+
+fn whole_device_start(ctx: &mut Ctx, table: &Table) -> Device {
+    let mut device = Device {
+        source: ctx.file.to_string(),
+        ..Device::default()
+    };
+    device.file_info.file_name = Path::new(ctx.file)
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned());
+    device.file_info.created_by = Some("eds2rust YAML object table".into());
+    let at = At::of(&table.format);
+    match &table.device {
+        None => ctx.error(
+            "table::missing-key",
+            at,
+            "",
+            "device",
+            "a whole-device table needs `device:` with at least vendor_name and product_name"
+                .into(),
+        ),
+        Some(def) => {
+            for (key, value) in [
+                ("vendor_name", &def.value.vendor_name),
+                ("product_name", &def.value.product_name),
+            ] {
+                if value.is_none() {
+                    ctx.error(
+                        "table::missing-key",
+                        At::of(def),
+                        "device",
+                        key,
+                        format!("a whole-device table needs `device.{key}`"),
+                    );
+                }
+            }
+        }
+    }
+    if table.objects.is_empty() {
+        ctx.error(
+            "table::missing-key",
+            at,
+            "",
+            "objects",
+            "a whole-device table needs `objects:` with at least one object".into(),
+        );
+    }
+    device
+}
+
+/// Writes the identity fields a [`DeviceDef`] gives into `identity`.
+/// `whole` also accepts `description` (a variant's goes elsewhere).
+pub(super) fn apply_identity(
+    ctx: &mut Ctx,
+    identity: &mut Identity,
+    def: &Spanned<DeviceDef>,
+    whole: bool,
+) {
+    let d = &def.value;
+    let text = |t: &Option<Spanned<String>>| t.as_ref().map(|t| t.value.clone());
+    if let Some(v) = text(&d.vendor_name) {
+        identity.vendor_name = Some(v);
+    }
+    if let Some(v) = &d.vendor_number {
+        identity.vendor_number = Some(v.value);
+    }
+    if let Some(v) = text(&d.product_name) {
+        identity.product_name = Some(v);
+    }
+    if let Some(v) = &d.product_number {
+        identity.product_number = Some(v.value);
+    }
+    if let Some(v) = &d.revision_number {
+        identity.revision_number = Some(v.value);
+    }
+    if let Some(v) = text(&d.order_code) {
+        identity.order_code = Some(v);
+    }
+    if !whole && let Some(description) = &d.description {
+        ctx.error(
+            "table::misplaced-key",
+            At::of(description),
+            "variant device",
+            "description",
+            "a variant's description is `description:` of the variant itself".into(),
+        );
+    }
+}

@@ -1,0 +1,254 @@
+//! The YAML object table reader: YAML text → [`schema::Table`] → [`ir::Device`].
+//!
+//! A table describes a whole device or overlays an EDS file (`base:`); the
+//! format is documented in `docs/yaml-tables.md`. Shape errors (YAML syntax,
+//! unknown keys, wrong scalar types) stop at the first, as serde does; every
+//! semantic error is collected. Nothing here panics on any input.
+
+mod entry;
+mod extra;
+mod lower;
+mod meaning;
+mod pdo;
+pub mod schema;
+
+use std::path::Path;
+
+use serde_saphyr::Spanned;
+
+use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
+use crate::input::{Loaded, Options};
+
+/// Reads a YAML object table from disk. A `base:` EDS is read relative to
+/// the table's directory.
+pub fn read_file(path: &Path, options: Options) -> Loaded {
+    let name = path.display().to_string();
+    match std::fs::read(path) {
+        Ok(bytes) => {
+            let dir = path.parent().unwrap_or(Path::new(""));
+            read_bytes(&name, &bytes, dir, options)
+        }
+        Err(err) => {
+            let mut diagnostics = Diagnostics::new();
+            diagnostics.push(Diagnostic {
+                severity: Severity::Error,
+                code: "io",
+                file: name,
+                location: Location::default(),
+                message: format!("cannot read the file: {err}"),
+                notes: Vec::new(),
+            });
+            Loaded {
+                device: None,
+                diagnostics,
+            }
+        }
+    }
+}
+
+/// Reads YAML table content; `file` names it in diagnostics and origins,
+/// `base_dir` is where a `base:` path is resolved.
+pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: Options) -> Loaded {
+    let mut diagnostics = Diagnostics::new();
+    let text = match std::str::from_utf8(bytes) {
+        Ok(text) => text.strip_prefix('\u{feff}').unwrap_or(text),
+        Err(err) => {
+            let line = bytes[..err.valid_up_to()]
+                .iter()
+                .filter(|&&b| b == b'\n')
+                .count()
+                + 1;
+            diagnostics.push(Diagnostic {
+                severity: Severity::Error,
+                code: "table::not-utf8",
+                file: file.to_string(),
+                location: Location {
+                    line: u32::try_from(line).ok(),
+                    ..Location::default()
+                },
+                message: format!(
+                    "a YAML table must be UTF-8; byte {} is not",
+                    err.valid_up_to()
+                ),
+                notes: Vec::new(),
+            });
+            return Loaded {
+                device: None,
+                diagnostics,
+            };
+        }
+    };
+    diagnostics.add_source(file, text);
+    let mut yaml_options = serde_saphyr::options! { strict_booleans: true };
+    yaml_options.duplicate_keys = serde_saphyr::options::DuplicateKeyPolicy::Error;
+    let device = match serde_saphyr::from_str_with_options::<schema::Table>(text, yaml_options) {
+        Ok(table) => {
+            let mut ctx = Ctx {
+                file,
+                text,
+                diags: &mut diagnostics,
+            };
+            Some(lower::lower(&mut ctx, &table, base_dir, options))
+        }
+        Err(err) => {
+            let at = err.location().map(|l| At::from_location(&l));
+            let message = first_line(&err.to_string());
+            diagnostics.push(Diagnostic {
+                severity: Severity::Error,
+                code: "table::syntax",
+                file: file.to_string(),
+                location: Location {
+                    line: at.map(|a| a.line),
+                    span: at.map(|a| a.span(text)),
+                    section: None,
+                    key: None,
+                },
+                message,
+                notes: vec!["the table is read no further; see docs/yaml-tables.md".into()],
+            });
+            None
+        }
+    };
+    if options.strict {
+        diagnostics.make_strict();
+    }
+    diagnostics.sort();
+    Loaded {
+        device,
+        diagnostics,
+    }
+}
+
+/// serde-saphyr's message without its `line L column C:` prefix and without
+/// the source excerpt it appends (the renderer shows the source itself).
+fn first_line(message: &str) -> String {
+    let line = message.lines().next().unwrap_or("").trim();
+    let line = line.strip_prefix("error: ").unwrap_or(line);
+    match line.find(": ") {
+        Some(pos) if line.starts_with("line ") => line[pos + 2..].to_string(),
+        _ => line.to_string(),
+    }
+}
+
+/// A position in the table: 1-based line and byte offset.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct At {
+    pub line: u32,
+    offset: usize,
+    len: usize,
+}
+
+impl At {
+    /// A whole line, for items known only by their origin line.
+    pub fn line(line: u32) -> At {
+        At {
+            line,
+            offset: usize::MAX,
+            len: 0,
+        }
+    }
+
+    pub fn of<T>(spanned: &Spanned<T>) -> At {
+        At::from_location(&spanned.referenced)
+    }
+
+    fn from_location(location: &serde_saphyr::Location) -> At {
+        let span = location.span();
+        At {
+            line: u32::try_from(location.line()).unwrap_or(0),
+            offset: span
+                .byte_offset()
+                .and_then(|o| usize::try_from(o).ok())
+                .unwrap_or(0),
+            len: span
+                .byte_len()
+                .and_then(|l| usize::try_from(l).ok())
+                .unwrap_or(0),
+        }
+    }
+
+    /// The byte range to underline: the scalar, or the rest of its line.
+    fn span(self, text: &str) -> std::ops::Range<usize> {
+        if self.offset == usize::MAX {
+            // Line n starts after the (n-1)th newline.
+            let newlines = usize::try_from(self.line)
+                .unwrap_or(usize::MAX)
+                .saturating_sub(1);
+            let start = match newlines.checked_sub(1) {
+                None => 0,
+                Some(k) => text
+                    .match_indices('\n')
+                    .nth(k)
+                    .map_or(text.len(), |(i, _)| i + 1),
+            };
+            let end = text[start..].find('\n').map_or(text.len(), |n| start + n);
+            return start..end;
+        }
+        let start = self.offset.min(text.len());
+        let end = if self.len > 0 {
+            (start + self.len).min(text.len())
+        } else {
+            text[start..].find('\n').map_or(text.len(), |n| start + n)
+        };
+        if end > start && text.is_char_boundary(start) && text.is_char_boundary(end) {
+            start..end
+        } else {
+            start..start
+        }
+    }
+}
+
+/// The reporting context of one table.
+pub(crate) struct Ctx<'a> {
+    pub file: &'a str,
+    pub text: &'a str,
+    pub diags: &'a mut Diagnostics,
+}
+
+impl Ctx<'_> {
+    /// Reports a problem at `at`; `place` says which object or table item it
+    /// concerns (shown as `[place]`), `key` the YAML key.
+    pub fn report(
+        &mut self,
+        severity: Severity,
+        code: &'static str,
+        at: At,
+        place: &str,
+        key: Option<&str>,
+        message: String,
+    ) {
+        self.diags.push(Diagnostic {
+            severity,
+            code,
+            file: self.file.to_string(),
+            location: Location {
+                line: (at.line > 0).then_some(at.line),
+                span: (at.line > 0).then(|| at.span(self.text)),
+                section: (!place.is_empty()).then(|| place.to_string()),
+                key: key.map(str::to_string),
+            },
+            message,
+            notes: Vec::new(),
+        });
+    }
+
+    pub fn error(&mut self, code: &'static str, at: At, place: &str, key: &str, message: String) {
+        let key = (!key.is_empty()).then_some(key);
+        self.report(Severity::Error, code, at, place, key, message);
+    }
+
+    pub fn origin(&self, at: At) -> crate::ir::Origin {
+        crate::ir::Origin {
+            file: self.file.to_string(),
+            line: at.line,
+        }
+    }
+}
+
+/// `0x2000` or `0x2000 sub 1`: how diagnostics name an entry.
+pub(crate) fn place(index: u16, sub: Option<u8>) -> String {
+    match sub {
+        Some(sub) => format!("0x{index:04X} sub {sub}"),
+        None => format!("0x{index:04X}"),
+    }
+}
