@@ -43,11 +43,32 @@ enum Command {
         strict: bool,
         file: PathBuf,
     },
+    /// Writes the object dictionary of one file in another format (a YAML
+    /// table as a CiA 306 EDS). Nothing is written when the input has errors.
+    Export {
+        #[arg(long, value_enum, default_value_t = ExportFormat::Eds)]
+        format: ExportFormat,
+        /// Export this product variant of the device.
+        #[arg(long)]
+        variant: Option<String>,
+        /// Write here instead of standard output (replaced only when complete).
+        #[arg(long, short)]
+        output: Option<PathBuf>,
+        /// Turn warnings into errors.
+        #[arg(long)]
+        strict: bool,
+        file: PathBuf,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
 enum Format {
     Json,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum ExportFormat {
+    Eds,
 }
 
 fn main() -> ExitCode {
@@ -60,6 +81,18 @@ fn main() -> ExitCode {
             strict,
             file,
         } => dump(&file, node_id, Options { strict }),
+        Command::Export {
+            format: ExportFormat::Eds,
+            variant,
+            output,
+            strict,
+            file,
+        } => export(
+            &file,
+            variant.as_deref(),
+            output.as_deref(),
+            Options { strict },
+        ),
     }
 }
 
@@ -102,4 +135,67 @@ fn dump(path: &std::path::Path, node_id: Option<u8>, options: Options) -> ExitCo
     } else {
         ExitCode::SUCCESS
     }
+}
+
+fn export(
+    path: &std::path::Path,
+    variant: Option<&str>,
+    output: Option<&std::path::Path>,
+    options: Options,
+) -> ExitCode {
+    let loaded = read_device(path, options);
+    let d = &loaded.diagnostics;
+    // Diagnostics go to stderr so that stdout holds only the export.
+    let _ = write!(std::io::stderr().lock(), "{}", d.render());
+    let device = match (&loaded.device, d.has_errors()) {
+        (Some(device), false) => device,
+        _ => {
+            let _ = writeln!(
+                std::io::stderr().lock(),
+                "{}: not exported: {} errors",
+                path.display(),
+                d.error_count()
+            );
+            return ExitCode::from(1);
+        }
+    };
+    let text = match variant {
+        None => eds2rust::r#gen::to_eds(device),
+        Some(name) => match eds2rust::r#gen::to_eds_variant(device, name) {
+            Ok(text) => text,
+            Err(message) => {
+                let _ = writeln!(std::io::stderr().lock(), "{}: {message}", path.display());
+                return ExitCode::from(1);
+            }
+        },
+    };
+    match output {
+        None => {
+            let _ = std::io::stdout().lock().write_all(text.as_bytes());
+            ExitCode::SUCCESS
+        }
+        Some(out) => match write_whole(out, text.as_bytes()) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(err) => {
+                let _ = writeln!(
+                    std::io::stderr().lock(),
+                    "cannot write {}: {err}",
+                    out.display()
+                );
+                ExitCode::from(1)
+            }
+        },
+    }
+}
+
+/// Writes `bytes` to a temporary file beside `path` and renames it over
+/// `path`, so that a reader never sees half a file.
+fn write_whole(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut tmp = path.as_os_str().to_owned();
+    tmp.push(".tmp");
+    let tmp = PathBuf::from(tmp);
+    std::fs::write(&tmp, bytes)?;
+    std::fs::rename(&tmp, path).inspect_err(|_| {
+        let _ = std::fs::remove_file(&tmp);
+    })
 }

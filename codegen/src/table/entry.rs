@@ -337,7 +337,7 @@ fn build_entry(
         semantics: Default::default(),
         origin: ctx.origin(At::of(def)),
     };
-    check_limits(ctx, &entry, At::of(def), here);
+    check_limits(ctx, &entry, def, here);
     entry.semantics = super::meaning::semantics(ctx, def, &entry, here);
     let _ = index;
     Some(entry)
@@ -457,13 +457,16 @@ pub(super) fn integer(ctx: &mut Ctx, text: &Text, here: &str, key: &str) -> Opti
     }
 }
 
-/// `min` above `max`, or a default outside them.
-fn check_limits(ctx: &mut Ctx, entry: &Entry, at: At, here: &str) {
+/// `min` above `max`, or a default outside them; reported at the key that
+/// `def` gives (else at `def`).
+fn check_limits(ctx: &mut Ctx, entry: &Entry, def: &Spanned<EntryDef>, here: &str) {
     let num = |l: &Option<Literal>| match l.as_ref().map(|l| (&l.value, l.plus_node_id)) {
         Some((Value::Integer(v), false)) => Some(*v as f64),
         Some((Value::Real(v), false)) => Some(*v),
         _ => None,
     };
+    let text = |l: &Option<Literal>| l.as_ref().map_or(String::new(), |l| l.text.clone());
+    let at_key = |t: &Option<Text>| t.as_ref().map_or(At::of(def), At::of);
     let (low, high, default) = (
         num(&entry.low_limit),
         num(&entry.high_limit),
@@ -474,22 +477,35 @@ fn check_limits(ctx: &mut Ctx, entry: &Entry, at: At, here: &str) {
     {
         ctx.error(
             "table::limits",
-            at,
+            at_key(&def.value.min),
             here,
             "min",
-            format!("min {lo} is above max {hi}"),
+            format!(
+                "min {} is above max {}",
+                text(&entry.low_limit),
+                text(&entry.high_limit)
+            ),
         );
         return;
     }
     if let Some(d) = default
         && (low.is_some_and(|lo| d < lo) || high.is_some_and(|hi| d > hi))
     {
+        let bound = |l: &Option<Literal>| match l {
+            Some(l) => l.text.clone(),
+            None => "…".into(),
+        };
         ctx.error(
             "table::limits",
-            at,
+            at_key(&def.value.default),
             here,
             "default",
-            format!("default {d} is outside min..max"),
+            format!(
+                "default {} is outside min..max ({}..{})",
+                text(&entry.default),
+                bound(&entry.low_limit),
+                bound(&entry.high_limit)
+            ),
         );
     }
 }
@@ -585,7 +601,7 @@ pub(super) fn modify(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>
         };
         *slot = literal(ctx, &text, at, entry.data_type, &here, key);
     }
-    check_limits(ctx, &entry, at, &here);
+    check_limits(ctx, &entry, def, &here);
     if let Some(object) = device.objects.get_mut(&index) {
         object.entries.insert(sub, entry);
     }

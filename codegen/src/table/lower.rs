@@ -25,7 +25,11 @@ pub(super) fn lower(ctx: &mut Ctx, table: &Table, base_dir: &Path, options: Opti
         );
     }
     let mut device = match &table.base {
-        Some(base) => read_base(ctx, base, base_dir, options),
+        Some(base) => match read_base(ctx, base, base_dir, options) {
+            Some(device) => device,
+            // Every later stage would only repeat that the base is missing.
+            None => return Device::default(),
+        },
         None => whole_device_start(ctx, table),
     };
     if let Some(def) = &table.device {
@@ -85,14 +89,19 @@ pub(super) fn lower(ctx: &mut Ctx, table: &Table, base_dir: &Path, options: Opti
     device
 }
 
-fn read_base(ctx: &mut Ctx, base: &Spanned<String>, base_dir: &Path, options: Options) -> Device {
+fn read_base(
+    ctx: &mut Ctx,
+    base: &Spanned<String>,
+    base_dir: &Path,
+    options: Options,
+) -> Option<Device> {
     let path = base_dir.join(&base.value);
     let loaded = crate::eds::read_file(&path, options);
     let failed = loaded.diagnostics.has_errors();
     ctx.diags.extend(loaded.diagnostics);
     match loaded.device {
-        Some(device) if !failed => device,
-        device => {
+        Some(device) if !failed => Some(device),
+        _ => {
             ctx.error(
                 "table::base",
                 At::of(base),
@@ -103,7 +112,7 @@ fn read_base(ctx: &mut Ctx, base: &Spanned<String>, base_dir: &Path, options: Op
                     path.display()
                 ),
             );
-            device.unwrap_or_default()
+            None
         }
     }
 }

@@ -169,7 +169,11 @@ fn value_table(
                 at,
                 here,
                 key,
-                format!("{what} [{a}, {b}] does not fit the type's range {lo}..={hi}"),
+                if a == b {
+                    format!("{what} {a} does not fit the type's range {lo}..={hi}")
+                } else {
+                    format!("{what} [{a}, {b}] does not fit the type's range {lo}..={hi}")
+                },
             );
         }
         ok

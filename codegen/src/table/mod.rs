@@ -124,10 +124,13 @@ pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: Options) -
 fn first_line(message: &str) -> String {
     let line = message.lines().next().unwrap_or("").trim();
     let line = line.strip_prefix("error: ").unwrap_or(line);
-    match line.find(": ") {
-        Some(pos) if line.starts_with("line ") => line[pos + 2..].to_string(),
-        _ => line.to_string(),
-    }
+    let line = match line.find(": ") {
+        Some(pos) if line.starts_with("line ") => &line[pos + 2..],
+        _ => line,
+    };
+    // serde-saphyr advises its caller, not the table's author.
+    line.trim_end_matches(", set DuplicateKeyPolicy in Options if acceptable")
+        .to_string()
 }
 
 /// A position in the table: 1-based line and byte offset.
@@ -154,16 +157,18 @@ impl At {
 
     fn from_location(location: &serde_saphyr::Location) -> At {
         let span = location.span();
-        At {
-            line: u32::try_from(location.line()).unwrap_or(0),
-            offset: span
-                .byte_offset()
-                .and_then(|o| usize::try_from(o).ok())
-                .unwrap_or(0),
-            len: span
-                .byte_len()
-                .and_then(|l| usize::try_from(l).ok())
-                .unwrap_or(0),
+        let line = u32::try_from(location.line()).unwrap_or(0);
+        match span.byte_offset().and_then(|o| usize::try_from(o).ok()) {
+            // Without a byte offset (some syntax errors), the whole line.
+            None => At::line(line),
+            Some(offset) => At {
+                line,
+                offset,
+                len: span
+                    .byte_len()
+                    .and_then(|l| usize::try_from(l).ok())
+                    .unwrap_or(0),
+            },
         }
     }
 
