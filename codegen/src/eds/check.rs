@@ -28,9 +28,18 @@ fn check_mapping_entry(
     let Some(raw) = pdo::raw_mapping(entry) else {
         return;
     };
-    let Some(problem) = pdo::check_entry(device, raw) else {
-        return;
-    };
+    for problem in pdo::check_entry(device, raw) {
+        report_mapping_problem(doc, index, entry, problem, diags);
+    }
+}
+
+fn report_mapping_problem(
+    doc: &Document,
+    index: u16,
+    entry: &Entry,
+    problem: MappingProblem,
+    diags: &mut Diagnostics,
+) {
     let message = match problem {
         MappingProblem::DummyNotEnabled { .. } => {
             format!("mapping of 0x{index:04X} sub {}: {problem}", entry.subindex)

@@ -136,37 +136,44 @@ pub fn raw_mapping(entry: &super::Entry) -> Option<u32> {
     }
 }
 
-/// Checks one mapping entry against the device.
-pub fn check_entry(device: &Device, raw: u32) -> Option<MappingProblem> {
+/// Checks one mapping entry against the device: every problem it has.
+pub fn check_entry(device: &Device, raw: u32) -> Vec<MappingProblem> {
+    let mut problems = Vec::new();
     if raw == 0 {
-        return None;
+        return problems;
     }
     let target = MappedObject::from_raw(raw);
     if target.is_dummy() {
         let data_type = DataType::from_code(target.index);
-        return (!device.dummy_usage.is_empty() && !device.dummy_usage.contains(&data_type))
-            .then_some(MappingProblem::DummyNotEnabled { data_type });
+        if !device.dummy_usage.is_empty() && !device.dummy_usage.contains(&data_type) {
+            problems.push(MappingProblem::DummyNotEnabled { data_type });
+        }
+        return problems;
     }
     let Some(object) = device.objects.get(&target.index) else {
-        return Some(MappingProblem::MissingObject { target });
+        problems.push(MappingProblem::MissingObject { target });
+        return problems;
     };
     let Some(mapped) = object.entries.get(&target.subindex) else {
-        return Some(MappingProblem::MissingSub { target });
+        problems.push(MappingProblem::MissingSub { target });
+        return problems;
     };
     if !mapped.pdo_mappable {
-        return Some(MappingProblem::NotMappable {
+        problems.push(MappingProblem::NotMappable {
             target,
             name: mapped.name.clone(),
         });
     }
-    match mappable_bits(mapped.data_type) {
-        Some(bits) if !bits.contains(&target.bits) => Some(MappingProblem::WrongLength {
+    if let Some(bits) = mappable_bits(mapped.data_type)
+        && !bits.contains(&target.bits)
+    {
+        problems.push(MappingProblem::WrongLength {
             target,
             data_type: mapped.data_type,
             bits: bits[bits.len() - 1],
-        }),
-        _ => None,
+        });
     }
+    problems
 }
 
 /// The total bit length of a mapping object's active entries (subs 1 to the

@@ -396,7 +396,7 @@ fn map_item(
                 subindex: sub,
                 bits,
             };
-            if let Some(problem) = pdo::check_entry(device, mapped.raw()) {
+            for problem in pdo::check_entry(device, mapped.raw()) {
                 ctx.error(
                     "table::pdo-mapping",
                     at,
@@ -451,7 +451,7 @@ pub(super) fn check_mappings(ctx: &mut Ctx, device: &Device, written: &BTreeSet<
             let Some(raw) = pdo::raw_mapping(entry) else {
                 continue;
             };
-            if let Some(problem) = pdo::check_entry(device, raw) {
+            for problem in pdo::check_entry(device, raw) {
                 let at = At::line(entry.origin.line);
                 let here = place(index, Some(entry.subindex));
                 ctx.error(
