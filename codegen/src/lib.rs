@@ -6,11 +6,13 @@
 //! - [`input`]: either of the two, chosen by file extension;
 //! - [`ir`]: the object-dictionary model, plain data;
 //! - [`dump`]: IR → JSON for tools and tests;
+//! - `gen` (`r#gen`: `gen` is a reserved word in Rust 2024): IR → files: an EDS (CiA 306) export, product variants applied;
 //! - [`diag`]: diagnostics with file, line, section and key.
 
 pub mod diag;
 pub mod dump;
 pub mod eds;
+pub mod r#gen;
 pub mod input;
 pub mod ir;
 pub mod table;

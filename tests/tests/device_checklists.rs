@@ -44,10 +44,11 @@ fn sections(text: &str) -> Vec<Section> {
         } else if let Some(count) = line.strip_prefix("rows:") {
             let section = out.last_mut().expect("rows: before a section");
             section.declared = Some(count.trim().parse().expect("rows: N"));
-        } else if line.starts_with('|') && !line.starts_with("|---") {
-            if let Some(section) = out.last_mut() {
-                section.rows.push((n + 1, line.to_string()));
-            }
+        } else if line.starts_with('|')
+            && !line.starts_with("|---")
+            && let Some(section) = out.last_mut()
+        {
+            section.rows.push((n + 1, line.to_string()));
         }
     }
     // The first table row of each section is its header.

@@ -204,7 +204,11 @@ impl<'a> Lowering<'a> {
             Some(s) => s
                 .properties
                 .iter()
-                .filter(|p| p.key.to_ascii_lowercase().starts_with("line"))
+                // `Line1`…`LineN`; `Lines=N` is the count, not a comment.
+                .filter(|p| {
+                    let key = p.key.to_ascii_lowercase();
+                    key.starts_with("line") && key[4..].bytes().all(|b| b.is_ascii_digit())
+                })
                 .map(|p| p.value.to_string())
                 .collect(),
             None => Vec::new(),

@@ -1,0 +1,107 @@
+"""Load EDS/DCF files (eds2rust's EDS exports) with python-canopen, one JSON line per file.
+
+Usage: python od_export_check.py --node-id 5 FILE [FILE...]
+
+The oracle of tests/tests/export_eds.rs: each file is loaded with
+canopen.import_od(path, node_id=N); the line holds whether it loaded, every
+entry python-canopen models (in the schema of `eds2rust dump --format json`,
+as tests/python/od_dump.py prints it) and every warning raised while loading:
+log records of WARNING and above from any logger, and Python `warnings`.
+"""
+
+import argparse
+import json
+import logging
+import sys
+import warnings
+
+import canopen
+from canopen.objectdictionary import ODArray, ODVariable
+
+
+class Collect(logging.Handler):
+    """Collects log records of WARNING and above while one file loads."""
+
+    def __init__(self):
+        super().__init__(level=logging.WARNING)
+        self.messages = []
+
+    def emit(self, record):
+        self.messages.append(f"{record.levelname} {record.name}: {record.getMessage()}")
+
+
+def value(v):
+    """A python-canopen value in the dump's JSON form."""
+    if v is None:
+        return None
+    if isinstance(v, (bytes, bytearray)):
+        return {"hex": bytes(v).hex()}
+    if isinstance(v, bool):
+        return int(v)
+    if isinstance(v, float) and v != v:
+        return None  # NaN: JSON has no such number (eds2rust's dump writes null too)
+    if isinstance(v, float) and v in (float("inf"), float("-inf")):
+        return None
+    return v
+
+
+def entry(var, object_type):
+    return {
+        "index": var.index,
+        "subindex": var.subindex,
+        "object_type": object_type,
+        "name": var.name,
+        "data_type": var.data_type,
+        "access": var.access_type,
+        "pdo_mappable": bool(var.pdo_mappable),
+        "default": value(var.default),
+        "low_limit": value(var.min),
+        "high_limit": value(var.max),
+        "parameter_value": value(var.value),
+        "node_relative": bool(var.relative),
+    }
+
+
+def load(path, node_id):
+    collect = Collect()
+    root = logging.getLogger()
+    root.addHandler(collect)
+    previous_level = root.level
+    root.setLevel(logging.WARNING)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        try:
+            od = canopen.import_od(path, node_id=node_id)
+            error = None
+        except Exception as exc:  # the oracle reports every failure as data
+            od = None
+            error = f"{type(exc).__name__}: {exc}"
+        finally:
+            root.removeHandler(collect)
+            root.setLevel(previous_level)
+    messages = collect.messages + [f"{w.category.__name__}: {w.message}" for w in caught]
+    if od is None:
+        return {"file": path, "ok": False, "error": error, "warnings": messages, "entries": []}
+    entries = []
+    for index in sorted(od.indices):
+        obj = od.indices[index]
+        if isinstance(obj, ODVariable):
+            entries.append(entry(obj, "VAR"))
+        else:
+            kind = "ARRAY" if isinstance(obj, ODArray) else "RECORD"
+            for sub in sorted(obj.subindices):
+                entries.append(entry(obj.subindices[sub], kind))
+    return {"file": path, "ok": True, "error": None, "warnings": messages, "entries": entries}
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--node-id", type=int, required=True)
+    parser.add_argument("files", nargs="+")
+    args = parser.parse_args()
+    for path in args.files:
+        sys.stdout.write(json.dumps(load(path, args.node_id)) + "\n")
+
+
+if __name__ == "__main__":
+    main()
