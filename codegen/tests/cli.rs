@@ -147,3 +147,86 @@ fn dump_json_schema_and_node_id() {
     let doc: Value = serde_json::from_str(&stdout).unwrap();
     assert_eq!(entry(&doc, 0x1400, 1)["default"], 0x200);
 }
+
+fn seed(name: &str) -> String {
+    format!("{}/../eds/{name}.yaml", env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn yaml_tables_are_checked_dumped_and_exported_like_eds() {
+    let linak = seed("linak_techline");
+    let (code, stdout, _) = run(&["check", "--strict", &linak]);
+    assert_eq!(code, 0, "{stdout}");
+    assert!(stdout.contains("0 errors, 0 warnings"), "{stdout}");
+
+    // Same JSON schema as for an EDS: same keys at the top, in the device
+    // and in every entry.
+    let keys = |v: &Value| -> Vec<String> { v.as_object().unwrap().keys().cloned().collect() };
+    let (_, eds_json, _) = run(&["dump", "--format", "json", "--node-id", "32", &example()]);
+    let (code, yaml_json, _) = run(&["dump", "--format", "json", "--node-id", "32", &linak]);
+    assert_eq!(code, 0);
+    let (eds_json, yaml_json): (Value, Value) = (
+        serde_json::from_str(&eds_json).unwrap(),
+        serde_json::from_str(&yaml_json).unwrap(),
+    );
+    assert_eq!(keys(&eds_json), keys(&yaml_json));
+    assert_eq!(keys(&eds_json["device"]), keys(&yaml_json["device"]));
+    assert_eq!(
+        keys(&eds_json["entries"][0]),
+        keys(&yaml_json["entries"][0])
+    );
+    // $NODEID resolved: TPDO1's COB-ID for node 32.
+    let cob_id = yaml_json["entries"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|e| e["index"] == 0x1800 && e["subindex"] == 1)
+        .unwrap();
+    assert_eq!(cob_id["default"], 0x1A0);
+
+    // export: an EDS on stdout that reads back without a diagnostic.
+    let dir = tempdir();
+    let out = dir.join("linak.eds");
+    let (code, _, stderr) = run(&[
+        "export",
+        "--format",
+        "eds",
+        "-o",
+        out.to_str().unwrap(),
+        &linak,
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    let (code, stdout, _) = run(&["check", "--strict", out.to_str().unwrap()]);
+    assert_eq!(code, 0, "{stdout}");
+
+    // A table with errors: exit 1, the diagnostics on stderr, nothing written.
+    let bad = dir.join("bad.yaml");
+    std::fs::write(
+        &bad,
+        "format: 1\ndevice: { vendor_name: V, product_name: P }\nobjects:\n  - { index: 0x2000, name: A, type: UINT16, access: rw }\n",
+    )
+    .unwrap();
+    let kept = dir.join("kept.eds");
+    std::fs::write(&kept, "previous").unwrap();
+    let (code, stdout, stderr) = run(&[
+        "export",
+        "-o",
+        kept.to_str().unwrap(),
+        bad.to_str().unwrap(),
+    ]);
+    assert_eq!(code, 1);
+    assert!(stdout.is_empty(), "{stdout}");
+    assert!(
+        stderr.contains("bad.yaml:4:") && stderr.contains("table::bad-type"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_to_string(&kept).unwrap(), "previous");
+
+    // An unknown variant is an error naming the known ones.
+    let (code, _, stderr) = run(&["export", "--variant", "ACS99", &seed("zimmer_acs")]);
+    assert_eq!(code, 1);
+    assert!(
+        stderr.contains("ACS40") && stderr.contains("ACS60"),
+        "{stderr}"
+    );
+}
