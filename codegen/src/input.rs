@@ -21,6 +21,25 @@ pub struct Loaded {
     pub diagnostics: Diagnostics,
 }
 
+impl Loaded {
+    /// A file that could not be read at all.
+    pub fn unreadable(file: String, err: &std::io::Error) -> Loaded {
+        let mut diagnostics = Diagnostics::new();
+        diagnostics.push(crate::diag::Diagnostic {
+            severity: crate::diag::Severity::Error,
+            code: "io",
+            file,
+            location: crate::diag::Location::default(),
+            message: format!("cannot read the file: {err}"),
+            notes: Vec::new(),
+        });
+        Loaded {
+            device: None,
+            diagnostics,
+        }
+    }
+}
+
 /// The kinds of input file.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum InputKind {

@@ -22,21 +22,7 @@ pub fn read_file(path: &Path, options: Options) -> Loaded {
     let name = path.display().to_string();
     match std::fs::read(path) {
         Ok(bytes) => read_bytes(&name, &bytes, options),
-        Err(err) => {
-            let mut diagnostics = Diagnostics::new();
-            diagnostics.push(Diagnostic {
-                severity: Severity::Error,
-                code: "io",
-                file: name,
-                location: Location::default(),
-                message: format!("cannot read the file: {err}"),
-                notes: Vec::new(),
-            });
-            Loaded {
-                device: None,
-                diagnostics,
-            }
-        }
+        Err(err) => Loaded::unreadable(name, &err),
     }
 }
 

@@ -28,21 +28,7 @@ pub fn read_file(path: &Path, options: Options) -> Loaded {
             let dir = path.parent().unwrap_or(Path::new(""));
             read_bytes(&name, &bytes, dir, options)
         }
-        Err(err) => {
-            let mut diagnostics = Diagnostics::new();
-            diagnostics.push(Diagnostic {
-                severity: Severity::Error,
-                code: "io",
-                file: name,
-                location: Location::default(),
-                message: format!("cannot read the file: {err}"),
-                notes: Vec::new(),
-            });
-            Loaded {
-                device: None,
-                diagnostics,
-            }
-        }
+        Err(err) => Loaded::unreadable(name, &err),
     }
 }
 
