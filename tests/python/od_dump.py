@@ -36,6 +36,8 @@ def value(v):
         return {"hex": bytes(v).hex()}
     if isinstance(v, bool):
         return int(v)
+    if isinstance(v, float) and (v != v or v in (float("inf"), float("-inf"))):
+        return None  # JSON has no NaN or infinity; eds2rust's dump writes null too
     return v
 
 
@@ -58,6 +60,21 @@ def entry(var, object_type, parent_name):
     }
 
 
+def entries_of(od):
+    """Every entry python-canopen models, sorted by index and subindex."""
+    entries = []
+    # od.indices holds each object once (od.names may hold it twice).
+    for index in sorted(od.indices):
+        obj = od.indices[index]
+        if isinstance(obj, ODVariable):
+            entries.append(entry(obj, "VAR", None))
+        else:
+            kind = "ARRAY" if isinstance(obj, ODArray) else "RECORD"
+            for sub in sorted(obj.subindices):
+                entries.append(entry(obj.subindices[sub], kind, obj.name))
+    return entries
+
+
 def dump(path, node_id):
     collect = Collect()
     logger = logging.getLogger("canopen")
@@ -69,16 +86,7 @@ def dump(path, node_id):
                 "warnings": collect.messages, "entries": []}
     finally:
         logger.removeHandler(collect)
-    entries = []
-    # od.indices holds each object once (od.names may hold it twice).
-    for index in sorted(od.indices):
-        obj = od.indices[index]
-        if isinstance(obj, ODVariable):
-            entries.append(entry(obj, "VAR", None))
-        else:
-            kind = "ARRAY" if isinstance(obj, ODArray) else "RECORD"
-            for sub in sorted(obj.subindices):
-                entries.append(entry(obj.subindices[sub], kind, obj.name))
+    entries = entries_of(od)
     return {"file": path, "ok": True, "error": None, "warnings": collect.messages, "entries": entries}
 
 

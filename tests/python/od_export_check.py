@@ -4,8 +4,8 @@ Usage: python od_export_check.py --node-id 5 FILE [FILE...]
 
 The oracle of tests/tests/export_eds.rs: each file is loaded with
 canopen.import_od(path, node_id=N); the line holds whether it loaded, every
-entry python-canopen models (in the schema of `eds2rust dump --format json`,
-as tests/python/od_dump.py prints it) and every warning raised while loading:
+entry python-canopen models (od_dump.entries_of, in the schema of
+`eds2rust dump --format json`) and every warning raised while loading:
 log records of WARNING and above from any logger, and Python `warnings`.
 """
 
@@ -16,7 +16,9 @@ import sys
 import warnings
 
 import canopen
-from canopen.objectdictionary import ODArray, ODVariable
+
+# The entries in the dump's JSON form, exactly as the differential test's oracle writes them.
+from od_dump import entries_of
 
 
 class Collect(logging.Handler):
@@ -28,38 +30,6 @@ class Collect(logging.Handler):
 
     def emit(self, record):
         self.messages.append(f"{record.levelname} {record.name}: {record.getMessage()}")
-
-
-def value(v):
-    """A python-canopen value in the dump's JSON form."""
-    if v is None:
-        return None
-    if isinstance(v, (bytes, bytearray)):
-        return {"hex": bytes(v).hex()}
-    if isinstance(v, bool):
-        return int(v)
-    if isinstance(v, float) and v != v:
-        return None  # NaN: JSON has no such number (eds2rust's dump writes null too)
-    if isinstance(v, float) and v in (float("inf"), float("-inf")):
-        return None
-    return v
-
-
-def entry(var, object_type):
-    return {
-        "index": var.index,
-        "subindex": var.subindex,
-        "object_type": object_type,
-        "name": var.name,
-        "data_type": var.data_type,
-        "access": var.access_type,
-        "pdo_mappable": bool(var.pdo_mappable),
-        "default": value(var.default),
-        "low_limit": value(var.min),
-        "high_limit": value(var.max),
-        "parameter_value": value(var.value),
-        "node_relative": bool(var.relative),
-    }
 
 
 def load(path, node_id):
@@ -82,15 +52,7 @@ def load(path, node_id):
     messages = collect.messages + [f"{w.category.__name__}: {w.message}" for w in caught]
     if od is None:
         return {"file": path, "ok": False, "error": error, "warnings": messages, "entries": []}
-    entries = []
-    for index in sorted(od.indices):
-        obj = od.indices[index]
-        if isinstance(obj, ODVariable):
-            entries.append(entry(obj, "VAR"))
-        else:
-            kind = "ARRAY" if isinstance(obj, ODArray) else "RECORD"
-            for sub in sorted(obj.subindices):
-                entries.append(entry(obj.subindices[sub], kind))
+    entries = entries_of(od)
     return {"file": path, "ok": True, "error": None, "warnings": messages, "entries": entries}
 
 

@@ -96,3 +96,43 @@ pub fn run_script(script: &str, args: &[&Path], extra: &[&str]) -> Result<String
     }
     String::from_utf8(output.stdout).map_err(|e| format!("{script} printed non-UTF-8: {e}"))
 }
+
+/// The fields of an entry that the python-canopen comparisons check, in the
+/// schema of `eds2rust dump --format json` (and of `od_dump.py`).
+pub const COMPARED_FIELDS: &[&str] = &[
+    "data_type",
+    "access",
+    "pdo_mappable",
+    "default",
+    "low_limit",
+    "high_limit",
+    "parameter_value",
+];
+
+/// Two values of one field equal as JSON, numbers compared by value (REAL32
+/// at f32 precision).
+pub fn same_value(
+    ours: &serde_json::Value,
+    theirs: &serde_json::Value,
+    data_type: eds2rust::ir::DataType,
+) -> bool {
+    use serde_json::Value;
+    match (ours, theirs) {
+        (Value::Number(a), Value::Number(b)) => {
+            if let (Some(a), Some(b)) = (a.as_i64(), b.as_i64()) {
+                return a == b;
+            }
+            if let (Some(a), Some(b)) = (a.as_u64(), b.as_u64()) {
+                return a == b;
+            }
+            match (a.as_f64(), b.as_f64()) {
+                (Some(a), Some(b)) if data_type == eds2rust::ir::DataType::Real32 => {
+                    (a as f32) == (b as f32)
+                }
+                (Some(a), Some(b)) => a == b,
+                _ => false,
+            }
+        }
+        _ => ours == theirs,
+    }
+}

@@ -23,6 +23,7 @@ use eds2rust::eds::{Options, read_bytes, read_file};
 use eds2rust::r#gen::eds::to_eds;
 use eds2rust::ir::{DataType, Device, Entry, Literal, Origin, Value, ValueKind};
 use eds2rust_tests::python::run_script;
+use eds2rust_tests::python::{COMPARED_FIELDS as FIELDS, same_value};
 use serde_json::Value as Json;
 
 /// What an export → read cycle changes, by design or by a stated limit.
@@ -381,16 +382,6 @@ const PYTHON_RULES: &[(&str, &str)] = &[
 
 const NODE_ID: u8 = 5;
 
-const FIELDS: &[&str] = &[
-    "data_type",
-    "access",
-    "pdo_mappable",
-    "default",
-    "low_limit",
-    "high_limit",
-    "parameter_value",
-];
-
 /// What python-canopen made of one set of files.
 #[derive(Default)]
 struct PythonCheck {
@@ -451,26 +442,6 @@ fn export_path(dir: &Path, name: &str) -> PathBuf {
         file.push_str(".eds");
     }
     dir.join(file)
-}
-
-/// Numbers compare by value (REAL32 at f32 precision), everything else as JSON.
-fn same_json(ours: &Json, theirs: &Json, data_type: DataType) -> bool {
-    match (ours, theirs) {
-        (Json::Number(a), Json::Number(b)) => {
-            if let (Some(a), Some(b)) = (a.as_i64(), b.as_i64()) {
-                return a == b;
-            }
-            if let (Some(a), Some(b)) = (a.as_u64(), b.as_u64()) {
-                return a == b;
-            }
-            match (a.as_f64(), b.as_f64()) {
-                (Some(a), Some(b)) if data_type == DataType::Real32 => (a as f32) == (b as f32),
-                (Some(a), Some(b)) => a == b,
-                _ => false,
-            }
-        }
-        _ => ours == theirs,
-    }
 }
 
 /// The python-canopen rule behind a difference on `field`, if any.
@@ -540,7 +511,7 @@ fn compare_export(name: &str, export: &Device, python: &Json, check: &mut Python
         let mut mismatch = Vec::new();
         for &field in FIELDS {
             let (a, b) = (&our[field], &theirs[field]);
-            if same_json(a, b, entry.data_type) {
+            if same_value(a, b, entry.data_type) {
                 continue;
             }
             match explain(entry, field, b) {

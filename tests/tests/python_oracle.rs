@@ -15,6 +15,7 @@ use eds2rust::dump::json::to_json;
 use eds2rust::eds::ini::Document;
 use eds2rust::eds::{Options, read_file};
 use eds2rust::ir::{DataType, Device, Entry, Literal, ObjectKind, ValueKind};
+use eds2rust_tests::python::{COMPARED_FIELDS as FIELDS, same_value};
 use serde_json::Value;
 
 /// Known python-canopen 2.4.1 behaviours that differ from CiA 306, with the reason.
@@ -65,16 +66,6 @@ const RULES: &[(&str, &str)] = &[
     ),
 ];
 
-const FIELDS: &[&str] = &[
-    "data_type",
-    "access",
-    "pdo_mappable",
-    "default",
-    "low_limit",
-    "high_limit",
-    "parameter_value",
-];
-
 fn literal<'a>(entry: &'a Entry, field: &str) -> Option<&'a Literal> {
     match field {
         "default" => entry.default.as_ref(),
@@ -82,27 +73,6 @@ fn literal<'a>(entry: &'a Entry, field: &str) -> Option<&'a Literal> {
         "high_limit" => entry.high_limit.as_ref(),
         "parameter_value" => entry.parameter_value.as_ref(),
         _ => None,
-    }
-}
-
-/// Values equal as JSON, numbers compared by value (REAL32 at f32 precision).
-fn same_value(ours: &Value, theirs: &Value, data_type: DataType) -> bool {
-    match (ours, theirs) {
-        (Value::Number(a), Value::Number(b)) => {
-            if let (Some(a), Some(b)) = (a.as_i64(), b.as_i64()) {
-                return a == b;
-            }
-            if let (Some(a), Some(b)) = (a.as_u64(), b.as_u64()) {
-                return a == b;
-            }
-            let (a, b) = (a.as_f64().unwrap(), b.as_f64().unwrap());
-            if data_type == DataType::Real32 {
-                (a as f32) == (b as f32)
-            } else {
-                a == b
-            }
-        }
-        _ => ours == theirs,
     }
 }
 

@@ -102,6 +102,22 @@ pub(super) fn required_index(ctx: &mut Ctx, def: &Spanned<EntryDef>, what: &str)
     }
 }
 
+/// The entry an item names (`index`, `sub` defaulting to 0) and how
+/// diagnostics name it, after reporting every key `allowed` does not hold.
+pub(super) fn entry_reference(
+    ctx: &mut Ctx,
+    def: &Spanned<EntryDef>,
+    what: &str,
+    allowed: &[&[&str]],
+    context: &str,
+) -> Option<(u16, u8, String)> {
+    let index = required_index(ctx, def, what)?;
+    let sub = def.value.sub.as_ref().map_or(0, |s| s.value);
+    let here = place(index, Some(sub));
+    reject_keys(ctx, def, allowed, context, &here);
+    Some((index, sub, here))
+}
+
 /// Stage 4: adds one object of `objects`.
 pub(super) fn add(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>) {
     let Some(index) = required_index(ctx, def, "an object") else {
@@ -548,18 +564,15 @@ pub(super) fn delete(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>
 
 /// Stage 3: changes the EDS-level keys of an existing entry.
 pub(super) fn modify(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>) {
-    let Some(index) = required_index(ctx, def, "a `modify` item") else {
-        return;
-    };
-    let sub = def.value.sub.as_ref().map_or(0, |s| s.value);
-    let here = place(index, Some(sub));
-    reject_keys(
+    let Some((index, sub, here)) = entry_reference(
         ctx,
         def,
+        "a `modify` item",
         &[&["index", "sub", "name", "description"], VALUE_KEYS],
         "in `modify` (meaning goes to `semantics`)",
-        &here,
-    );
+    ) else {
+        return;
+    };
     let Some(entry) = find_entry(ctx, device, index, sub, At::of(def)) else {
         return;
     };

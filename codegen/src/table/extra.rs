@@ -5,9 +5,9 @@ use std::collections::BTreeMap;
 
 use serde_saphyr::Spanned;
 
-use super::entry::{find_entry, literal, reject_keys, required_index};
+use super::entry::{entry_reference, find_entry, literal};
 use super::schema::{ErrorTableDef, NetworkDef, VariantDef};
-use super::{At, Ctx, place};
+use super::{At, Ctx};
 use crate::ir::{
     Device, EntryOverride, ErrorCode, ErrorTable, ErrorTableKind, Identity, Lss, Variant,
 };
@@ -208,18 +208,15 @@ pub(super) fn variants(ctx: &mut Ctx, device: &mut Device, defs: &[Spanned<Varia
         }
         let mut overrides: Vec<EntryOverride> = Vec::new();
         for item in &d.values {
-            let Some(index) = required_index(ctx, item, "a variant value") else {
-                continue;
-            };
-            let sub = item.value.sub.as_ref().map_or(0, |s| s.value);
-            let entry_place = place(index, Some(sub));
-            reject_keys(
+            let Some((index, sub, entry_place)) = entry_reference(
                 ctx,
                 item,
+                "a variant value",
                 &[&["index", "sub", "default", "min", "max"]],
                 "in a variant's `values` (only default, min and max differ between variants)",
-                &entry_place,
-            );
+            ) else {
+                continue;
+            };
             if overrides
                 .iter()
                 .any(|o| o.index == index && o.subindex == sub)

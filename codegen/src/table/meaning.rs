@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use serde_saphyr::Spanned;
 
-use super::entry::{SEMANTIC_KEYS, find_entry, integer, reject_keys, required_index};
+use super::entry::{SEMANTIC_KEYS, entry_reference, find_entry, integer};
 use super::schema::{BitDef, EntryDef, PatternDef, Text, ValuesDef};
 use super::{At, Ctx, place};
 use crate::ir::{
@@ -403,18 +403,15 @@ fn pattern(ctx: &mut Ctx, def: &Spanned<PatternDef>, width: u32, here: &str) -> 
 
 /// Stage 5: one item of the `semantics` list.
 pub(super) fn apply_list_item(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>) {
-    let Some(index) = required_index(ctx, def, "a `semantics` item") else {
-        return;
-    };
-    let sub = def.value.sub.as_ref().map_or(0, |s| s.value);
-    let here = place(index, Some(sub));
-    reject_keys(
+    let Some((index, sub, here)) = entry_reference(
         ctx,
         def,
+        "a `semantics` item",
         &[&["index", "sub", "description"], SEMANTIC_KEYS],
         "in `semantics` (values and access go to `modify` or `objects`)",
-        &here,
-    );
+    ) else {
+        return;
+    };
     let Some(entry) = find_entry(ctx, device, index, sub, At::of(def)) else {
         return;
     };

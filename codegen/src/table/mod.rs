@@ -176,8 +176,11 @@ impl At {
             return start..end;
         }
         let start = self.offset.min(text.len());
+        if !text.is_char_boundary(start) {
+            return start..start;
+        }
         let end = if self.len > 0 {
-            (start + self.len).min(text.len())
+            start.saturating_add(self.len).min(text.len())
         } else {
             text[start..].find('\n').map_or(text.len(), |n| start + n)
         };

@@ -277,6 +277,20 @@ fn mapping(ctx: &mut Ctx, device: &mut Device, def: &Spanned<PdoDef>, here: &str
     if d.mapping.is_empty() {
         return;
     }
+    // CiA 301: mapping sub-indices 1 to 0x40.
+    if d.mapping.len() > 64 {
+        ctx.error(
+            "table::pdo-too-long",
+            At::of(def),
+            here,
+            "mapping",
+            format!(
+                "the mapping has {} entries; a PDO maps at most 64",
+                d.mapping.len()
+            ),
+        );
+        return;
+    }
     let count = items.len();
     let object = device.objects.entry(index).or_insert_with(|| {
         let mut entries = BTreeMap::new();
