@@ -1,10 +1,13 @@
 //! Generators: the IR ([`Device`]) → files.
 //!
 //! - [`eds`]: a CiA 306 EDS export ([`eds::to_eds`], [`eds::to_eds_variant`]);
+//! - [`rust`]: typed Rust for a device (zero-sized entry types, value types,
+//!   PDO structs, error enums), formatted by prettyplease;
 //! - [`apply_variant`]: the device as one of its product [`Variant`](crate::ir::Variant)s,
 //!   for any generator.
 
 pub mod eds;
+pub mod rust;
 
 pub use eds::{to_eds, to_eds_variant};
 

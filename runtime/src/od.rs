@@ -1,0 +1,398 @@
+//! Object-dictionary types shared by generated drivers and the protocol runtime.
+//!
+//! Generated code describes every object entry as a zero-sized type that
+//! implements [`Entry`]: its index, subindex, CiA 301 data type, value type and
+//! access right live in the type system. The functions here are generic over
+//! those types, so that the compiler rejects a write to a read-only object
+//! ([`encode_value`] needs [`Writable`]), a read of a write-only object
+//! ([`decode_value`] needs [`Readable`]), a value of the wrong type and a
+//! non-mappable object in a PDO mapping ([`mapping_entry`] needs
+//! [`PdoMappable`]). Everything here needs only `core`.
+
+use core::fmt;
+
+/// A CiA 301 basic data type.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum DataType {
+    Boolean,
+    Integer8,
+    Integer16,
+    Integer24,
+    Integer32,
+    Integer40,
+    Integer48,
+    Integer56,
+    Integer64,
+    Unsigned8,
+    Unsigned16,
+    Unsigned24,
+    Unsigned32,
+    Unsigned40,
+    Unsigned48,
+    Unsigned56,
+    Unsigned64,
+    Real32,
+    Real64,
+    VisibleString,
+    OctetString,
+    UnicodeString,
+    TimeOfDay,
+    TimeDifference,
+    Domain,
+    /// A code outside the standard table (a DEFTYPE or vendor type).
+    Other(u16),
+}
+
+impl DataType {
+    /// The number of bytes a value takes on the bus, or `None` when the
+    /// length is not fixed (strings, DOMAIN, unknown types).
+    pub const fn size(self) -> Option<usize> {
+        use DataType::*;
+        match self {
+            Boolean | Integer8 | Unsigned8 => Some(1),
+            Integer16 | Unsigned16 => Some(2),
+            Integer24 | Unsigned24 => Some(3),
+            Integer32 | Unsigned32 | Real32 => Some(4),
+            Integer40 | Unsigned40 => Some(5),
+            Integer48 | Unsigned48 | TimeOfDay | TimeDifference => Some(6),
+            Integer56 | Unsigned56 => Some(7),
+            Integer64 | Unsigned64 | Real64 => Some(8),
+            VisibleString | OctetString | UnicodeString | Domain | Other(_) => None,
+        }
+    }
+
+    /// Whether raw values of this type are two's-complement signed integers.
+    pub const fn is_signed(self) -> bool {
+        use DataType::*;
+        matches!(
+            self,
+            Integer8 | Integer16 | Integer24 | Integer32 | Integer40 | Integer48 | Integer56 | Integer64
+        )
+    }
+}
+
+/// The access right of an entry, as a value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum AccessRight {
+    Ro,
+    Wo,
+    Rw,
+    /// Read/write, mapped into a TPDO.
+    Rwr,
+    /// Read/write, mapped into an RPDO.
+    Rww,
+    Const,
+}
+
+/// Access rights as types; generated entries name one of these as
+/// [`Entry::Access`].
+pub mod access {
+    /// Read only.
+    pub enum Ro {}
+    /// Write only.
+    pub enum Wo {}
+    /// Read and write.
+    pub enum Rw {}
+    /// Read and write; meant for TPDO mapping (process input).
+    pub enum Rwr {}
+    /// Read and write; meant for RPDO mapping (process output).
+    pub enum Rww {}
+    /// Read only, never changes.
+    pub enum Const {}
+}
+
+mod sealed {
+    pub trait Sealed {}
+    impl Sealed for super::access::Ro {}
+    impl Sealed for super::access::Wo {}
+    impl Sealed for super::access::Rw {}
+    impl Sealed for super::access::Rwr {}
+    impl Sealed for super::access::Rww {}
+    impl Sealed for super::access::Const {}
+}
+
+/// An access right as a type.
+pub trait Access: sealed::Sealed {
+    const RIGHT: AccessRight;
+}
+
+/// Access rights that allow reading over the bus.
+#[diagnostic::on_unimplemented(
+    message = "this object cannot be read: its access right is `{Self}`",
+    label = "a write-only object"
+)]
+pub trait Read: Access {}
+
+/// Access rights that allow writing over the bus.
+#[diagnostic::on_unimplemented(
+    message = "this object cannot be written: its access right is `{Self}`",
+    label = "a read-only or constant object"
+)]
+pub trait Write: Access {}
+
+macro_rules! access_impls {
+    ($($ty:ident => $right:ident, read: $read:tt, write: $write:tt;)*) => {$(
+        impl Access for access::$ty {
+            const RIGHT: AccessRight = AccessRight::$right;
+        }
+        access_impls!(@read $read $ty);
+        access_impls!(@write $write $ty);
+    )*};
+    (@read true $ty:ident) => { impl Read for access::$ty {} };
+    (@read false $ty:ident) => {};
+    (@write true $ty:ident) => { impl Write for access::$ty {} };
+    (@write false $ty:ident) => {};
+}
+
+access_impls! {
+    Ro => Ro, read: true, write: false;
+    Wo => Wo, read: false, write: true;
+    Rw => Rw, read: true, write: true;
+    Rwr => Rwr, read: true, write: true;
+    Rww => Rww, read: true, write: true;
+    Const => Const, read: true, write: false;
+}
+
+/// One object-dictionary entry (a VAR, or one sub-entry of an ARRAY or
+/// RECORD), implemented by a generated zero-sized type.
+pub trait Entry {
+    const INDEX: u16;
+    const SUBINDEX: u8;
+    /// The name in the source (EDS `ParameterName` or the YAML `name`).
+    const NAME: &'static str;
+    const DATA_TYPE: DataType;
+    const PDO_MAPPABLE: bool;
+    /// The access right as a type: [`access::Ro`], [`access::Rw`], ...
+    type Access: Access;
+    /// The typed value: a primitive, or a generated enum, bit-field struct or
+    /// scaled newtype.
+    type Value;
+}
+
+/// Entries that may be mapped into a PDO; generated only for those.
+#[diagnostic::on_unimplemented(
+    message = "`{Self}` cannot be mapped into a PDO",
+    label = "this object is not PDO-mappable"
+)]
+pub trait PdoMappable: Entry {}
+
+/// A value with a fixed-size raw form: primitives and generated value types.
+///
+/// `to_raw` gives the two's-complement bit pattern (bits above the data
+/// type's width are ignored by encoders); `from_raw` receives the bit pattern
+/// sign-extended to 64 bits for signed data types.
+pub trait Scalar: Copy {
+    fn to_raw(self) -> u64;
+    fn from_raw(raw: u64) -> Self;
+}
+
+macro_rules! scalar_ints {
+    ($($ty:ty),*) => {$(
+        impl Scalar for $ty {
+            #[inline]
+            fn to_raw(self) -> u64 { self as u64 }
+            #[inline]
+            fn from_raw(raw: u64) -> Self { raw as $ty }
+        }
+    )*};
+}
+
+scalar_ints!(u8, u16, u32, u64, i8, i16, i32, i64);
+
+impl Scalar for bool {
+    #[inline]
+    fn to_raw(self) -> u64 {
+        self as u64
+    }
+    #[inline]
+    fn from_raw(raw: u64) -> Self {
+        raw & 1 != 0
+    }
+}
+
+impl Scalar for f32 {
+    #[inline]
+    fn to_raw(self) -> u64 {
+        u64::from(self.to_bits())
+    }
+    #[inline]
+    fn from_raw(raw: u64) -> Self {
+        f32::from_bits(raw as u32)
+    }
+}
+
+impl Scalar for f64 {
+    #[inline]
+    fn to_raw(self) -> u64 {
+        self.to_bits()
+    }
+    #[inline]
+    fn from_raw(raw: u64) -> Self {
+        f64::from_bits(raw)
+    }
+}
+
+/// Value types of entries without a fixed length; read and written as bytes.
+pub mod bytes {
+    /// VISIBLE_STRING: ISO 646 text.
+    pub enum VisibleString {}
+    /// OCTET_STRING: raw bytes.
+    pub enum OctetString {}
+    /// UNICODE_STRING: UTF-16 code units.
+    pub enum UnicodeString {}
+    /// DOMAIN: a block of data of any length.
+    pub enum Domain {}
+    /// A data type this crate does not know (DEFTYPE, vendor code).
+    pub enum Opaque {}
+}
+
+/// Why a value could not be encoded or decoded.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ValueError {
+    /// The buffer holds `actual` bytes; the data type needs `expected`.
+    Length { expected: usize, actual: usize },
+    /// The data type has no fixed length.
+    NotFixedSize(DataType),
+}
+
+impl fmt::Display for ValueError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ValueError::Length { expected, actual } => {
+                write!(f, "expected {expected} bytes, got {actual}")
+            }
+            ValueError::NotFixedSize(t) => write!(f, "{t:?} has no fixed length"),
+        }
+    }
+}
+
+/// Encodes the value of a writable entry into its little-endian bus form
+/// (the data of an SDO download); returns the number of bytes written.
+pub fn encode_value<E>(value: E::Value, out: &mut [u8]) -> Result<usize, ValueError>
+where
+    E: Entry,
+    E::Access: Write,
+    E::Value: Scalar,
+{
+    let size = E::DATA_TYPE
+        .size()
+        .ok_or(ValueError::NotFixedSize(E::DATA_TYPE))?;
+    let actual = out.len();
+    let Some(dest) = out.get_mut(..size) else {
+        return Err(ValueError::Length {
+            expected: size,
+            actual,
+        });
+    };
+    let raw = value.to_raw().to_le_bytes();
+    for (d, s) in dest.iter_mut().zip(raw.iter()) {
+        *d = *s;
+    }
+    Ok(size)
+}
+
+/// Decodes the value of a readable entry from its little-endian bus form (the
+/// data of an SDO upload); the slice must have exactly the type's length.
+pub fn decode_value<E>(bytes: &[u8]) -> Result<E::Value, ValueError>
+where
+    E: Entry,
+    E::Access: Read,
+    E::Value: Scalar,
+{
+    let size = E::DATA_TYPE
+        .size()
+        .ok_or(ValueError::NotFixedSize(E::DATA_TYPE))?;
+    if bytes.len() != size {
+        return Err(ValueError::Length {
+            expected: size,
+            actual: bytes.len(),
+        });
+    }
+    let mut raw = 0u64;
+    for (i, b) in bytes.iter().enumerate() {
+        raw |= u64::from(*b) << (8 * i);
+    }
+    if E::DATA_TYPE.is_signed() && size < 8 {
+        let shift = 64 - 8 * size as u32;
+        raw = (((raw << shift) as i64) >> shift) as u64;
+    }
+    Ok(E::Value::from_raw(raw))
+}
+
+/// The PDO mapping value of an entry (`index << 16 | subindex << 8 | bits`),
+/// as written into a mapping parameter object (0x1600.., 0x1A00..).
+pub const fn mapping_entry<E: PdoMappable>() -> u32 {
+    let bits = match E::DATA_TYPE.size() {
+        Some(bytes) => bytes as u32 * 8,
+        None => 0,
+    };
+    (E::INDEX as u32) << 16 | (E::SUBINDEX as u32) << 8 | bits
+}
+
+/// A CANopen node id, 1 to 127.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct NodeId(u8);
+
+impl NodeId {
+    /// `None` unless `id` is 1 to 127.
+    pub const fn new(id: u8) -> Option<NodeId> {
+        if id >= 1 && id <= 127 {
+            Some(NodeId(id))
+        } else {
+            None
+        }
+    }
+
+    pub const fn get(self) -> u8 {
+        self.0
+    }
+}
+
+impl fmt::Display for NodeId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.0)
+    }
+}
+
+/// Whether a PDO is received or transmitted by the device.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum PdoDirection {
+    /// Received by the device (the master sends it).
+    Rpdo,
+    /// Transmitted by the device.
+    Tpdo,
+}
+
+/// A PDO frame had the wrong length for its mapping.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PdoLengthError {
+    pub expected: usize,
+    pub actual: usize,
+}
+
+impl fmt::Display for PdoLengthError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "PDO has {} data bytes; its mapping needs exactly {}",
+            self.actual, self.expected
+        )
+    }
+}
+
+/// A generated default-PDO struct.
+pub trait Pdo: Sized {
+    const DIRECTION: PdoDirection;
+    /// 1-based PDO number (TPDO1 = 1).
+    const NUMBER: u16;
+    /// Communication parameter object (0x1400.. or 0x1800..).
+    const COMMUNICATION_INDEX: u16;
+    /// Mapping parameter object (0x1600.. or 0x1A00..).
+    const MAPPING_INDEX: u16;
+    /// Data length in bytes.
+    const LEN: usize;
+    /// Decodes a frame's data; it must be exactly [`Pdo::LEN`] bytes.
+    fn decode(data: &[u8]) -> Result<Self, PdoLengthError>;
+    /// Encodes into the first [`Pdo::LEN`] bytes of `out`; returns that length.
+    fn encode_into(&self, out: &mut [u8; 8]) -> usize;
+}
