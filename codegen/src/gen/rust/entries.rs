@@ -1,0 +1,359 @@
+//! The `od` module: one zero-sized type per entry, implementing the
+//! runtime's `Entry` (index, subindex, data type, access right and value type
+//! as associated items) and, when mappable, `PdoMappable`. VAR objects are
+//! types in `od`; ARRAY and RECORD objects are modules in `od` holding one
+//! type per sub-entry. Value types are generated beside their entry.
+
+use std::collections::BTreeMap;
+
+use proc_macro2::{Ident, TokenStream};
+use quote::quote;
+
+use super::docs::{self, Doc};
+use super::errors::ErrorPlan;
+use super::naming::{Case, Names, Namespace};
+use super::prim::Prim;
+use super::values::{self, Plan};
+use crate::diag::Diagnostics;
+use crate::ir::{Access, DataType, Device, Entry, Literal, Object, ObjectKind, Value};
+
+/// What other generators need to know of an entry's generated types.
+#[derive(Debug, Clone)]
+pub(crate) struct EntryInfo {
+    /// Path of the zero-sized type from the file's root.
+    pub(crate) zst: Vec<Ident>,
+    /// Path of the value type from the root, `None` for a primitive.
+    pub(crate) value: Option<Vec<Ident>>,
+    /// The raw type, `None` when the entry has no fixed size.
+    pub(crate) raw: Option<Prim>,
+}
+
+impl EntryInfo {
+    /// The value type as written in a module `depth` levels below the root.
+    pub(crate) fn value_tokens(&self, depth: usize) -> TokenStream {
+        match (&self.value, self.raw) {
+            (Some(path), _) => rooted(path, depth),
+            (None, Some(raw)) => raw.tokens(),
+            (None, None) => quote!(()),
+        }
+    }
+}
+
+/// `super::super::a::b` for `path` seen from `depth` levels down.
+pub(crate) fn rooted(path: &[Ident], depth: usize) -> TokenStream {
+    let supers = (0..depth).map(|_| quote!(super::));
+    quote!(#(#supers)* #(#path)::*)
+}
+
+pub(crate) struct Ctx<'a> {
+    pub(crate) device: &'a Device,
+    pub(crate) rt: &'a TokenStream,
+    pub(crate) errors: &'a [ErrorPlan],
+    pub(crate) diags: &'a mut Diagnostics,
+}
+
+fn error_plan(cx: &Ctx, entry: &Entry) -> Option<usize> {
+    let name = entry.semantics.error_table.as_deref()?;
+    cx.errors
+        .iter()
+        .position(|p| cx.device.error_tables[p.table].name == name)
+}
+
+/// The `od` module's items, and the info of every entry by (index, subindex).
+pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>) {
+    let device = cx.device;
+    let objects: Vec<&Object> = device
+        .objects
+        .values()
+        .filter(|o| !matches!(o.kind, ObjectKind::DefType | ObjectKind::DefStruct))
+        .filter(|o| !o.entries.is_empty())
+        .collect();
+    let is_var = |o: &Object| matches!(o.kind, ObjectKind::Var | ObjectKind::Domain);
+    // Names in `od`: types of VAR objects (and their value types), modules of
+    // the others.
+    let mut types = Namespace::new("module `od`", Case::UpperCamel);
+    let mut modules = Namespace::new("module `od`", Case::Snake);
+    let mut root_plans = Vec::new();
+    let mut module_ids = Vec::new();
+    for object in &objects {
+        let key = format!("x{:04X}", object.index);
+        if is_var(object) {
+            let entry = object.entries.values().next().expect("non-empty");
+            let zst = types.request(&object.name, &key, Some(&object.origin));
+            let plan = values::plan(entry, error_plan(cx, entry), &mut types);
+            root_plans.push((object, entry, zst, plan));
+        } else {
+            module_ids.push((object, modules.request(&object.name, &key, Some(&object.origin))));
+        }
+    }
+    let type_names = types.resolve(cx.diags);
+    let module_names = modules.resolve(cx.diags);
+    let mut infos = BTreeMap::new();
+    let mut items = TokenStream::new();
+    for (object, entry, zst, plan) in &root_plans {
+        let ident = type_names.get(*zst);
+        let path = vec![super::naming::ident("od")];
+        items.extend(entry_items(cx, object, entry, &ident, plan, &type_names, &path, &object.name));
+        infos.insert((object.index, entry.subindex), info(cx, &path, &ident, plan, &type_names));
+    }
+    for (object, id) in module_ids {
+        let module = module_names.get(id);
+        let path = vec![super::naming::ident("od"), module.clone()];
+        let mut ns = Namespace::new(format!("module `od::{module}`"), Case::UpperCamel);
+        let plans: Vec<_> = object
+            .entries
+            .values()
+            .map(|entry| {
+                let zst = ns.request(&entry.name, &format!("sub {}", entry.subindex), Some(&entry.origin));
+                let plan = values::plan(entry, error_plan(cx, entry), &mut ns);
+                (entry, zst, plan)
+            })
+            .collect();
+        ns.reserve("INDEX");
+        let names = ns.resolve(cx.diags);
+        let mut inner = TokenStream::new();
+        for (entry, zst, plan) in &plans {
+            let ident = names.get(*zst);
+            inner.extend(entry_items(cx, object, entry, &ident, plan, &names, &path, &entry.name));
+            infos.insert((object.index, entry.subindex), info(cx, &path, &ident, plan, &names));
+        }
+        let mut doc = Doc::new();
+        doc.para(format!(
+            "**{}**: object 0x{:04X}, {} with {} entries.",
+            docs::text(&object.name),
+            object.index,
+            match object.kind {
+                ObjectKind::Array => "ARRAY",
+                _ => "RECORD",
+            },
+            object.entries.len()
+        ));
+        doc.origin(&object.origin);
+        let doc = doc.tokens_with_alias(&object.name, &module.to_string());
+        let index = super::prim::hex(u128::from(object.index));
+        items.extend(quote! {
+            #doc
+            pub mod #module {
+                #[doc = " The object's index."]
+                pub const INDEX: u16 = #index;
+                #inner
+            }
+        });
+    }
+    (items, infos)
+}
+
+fn info(cx: &Ctx, module: &[Ident], zst: &Ident, plan: &Plan, names: &Names) -> EntryInfo {
+    let mut zst_path = module.to_vec();
+    zst_path.push(zst.clone());
+    let (value, raw) = match plan {
+        Plan::Prim(p) => (None, Some(*p)),
+        Plan::Bytes(_) => (None, None),
+        Plan::Error(i) => {
+            let plan = &cx.errors[*i];
+            (Some(vec![super::naming::ident("errors"), plan.ident.clone()]), Some(plan.raw))
+        }
+        Plan::Enum { name, raw, .. } | Plan::Bits { name, raw, .. } | Plan::Scaled { name, raw } => {
+            let mut path = module.to_vec();
+            path.push(names.get(*name));
+            (Some(path), Some(*raw))
+        }
+    };
+    EntryInfo { zst: zst_path, value, raw }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn entry_items(
+    cx: &mut Ctx,
+    object: &Object,
+    entry: &Entry,
+    ident: &Ident,
+    plan: &Plan,
+    names: &Names,
+    module: &[Ident],
+    source_name: &str,
+) -> TokenStream {
+    let rt = cx.rt;
+    let depth = module.len();
+    let errors = cx.errors;
+    let error_path = |i: usize| rooted(&[super::naming::ident("errors"), errors[i].ident.clone()], depth);
+    let value_ty = values::type_tokens(plan, names, rt, &error_path);
+    let var = matches!(object.kind, ObjectKind::Var | ObjectKind::Domain);
+    let index = super::prim::hex(u128::from(object.index));
+    let sub = proc_macro2::Literal::u8_unsuffixed(entry.subindex);
+    let name = &entry.name;
+    let data_type = data_type_tokens(rt, entry.data_type);
+    let access = access_tokens(rt, entry.access);
+    let mappable = entry.pdo_mappable;
+    let fixed = Prim::of(entry.data_type).is_some();
+    let mut out = TokenStream::new();
+    let doc = entry_doc(object, entry, var).tokens_with_alias(source_name, &ident.to_string());
+    out.extend(quote! {
+        #doc
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+        pub struct #ident;
+        impl #rt::od::Entry for #ident {
+            const INDEX: u16 = #index;
+            const SUBINDEX: u8 = #sub;
+            const NAME: &'static str = #name;
+            const DATA_TYPE: #rt::od::DataType = #data_type;
+            const PDO_MAPPABLE: bool = #mappable;
+            type Access = #access;
+            type Value = #value_ty;
+        }
+    });
+    if mappable && fixed {
+        out.extend(quote!(impl #rt::od::PdoMappable for #ident {}));
+    }
+    if let Some(default) = default_tokens(entry, plan, &value_ty) {
+        out.extend(quote! {
+            impl #ident {
+                #[doc = " The default value (EDS `DefaultValue`, YAML `default`)."]
+                pub const DEFAULT: #value_ty = #default;
+            }
+        });
+    }
+    let mut vcx = values::Ctx { rt, diags: cx.diags };
+    out.extend(values::emit(&mut vcx, entry, plan, names));
+    out
+}
+
+fn entry_doc(object: &Object, entry: &Entry, var: bool) -> Doc {
+    let mut doc = Doc::new();
+    let title = if var || entry.name == object.name {
+        format!("**{}**", docs::text(&entry.name))
+    } else {
+        format!("**{}** of {}", docs::text(&entry.name), docs::text(&object.name))
+    };
+    doc.para(format!("{title} ({}).", docs::entry_facts(object.index, entry, var)));
+    if let Some(description) = &entry.semantics.description {
+        doc.source_para(description);
+    }
+    let s = &entry.semantics;
+    if s.unit.is_some() || s.scale.is_some() {
+        let mut line = String::from("Unit:");
+        if let Some(unit) = &s.unit {
+            line.push_str(&format!(" {}", docs::text(unit)));
+        }
+        if let Some(scale) = s.scale {
+            line.push_str(&format!(", {scale} per raw step"));
+        }
+        if let Some(offset) = s.offset {
+            line.push_str(&format!(", offset {offset}"));
+        }
+        doc.para(line);
+    }
+    let literal = |l: &Literal| {
+        if l.plus_node_id {
+            format!("$NODEID + {}", docs::text(&l.text))
+        } else {
+            docs::text(&l.text)
+        }
+    };
+    let mut facts = Vec::new();
+    if let Some(d) = &entry.default {
+        facts.push(format!("Default: {}", literal(d)));
+    }
+    if let Some(l) = &entry.low_limit {
+        facts.push(format!("Low limit: {}", literal(l)));
+    }
+    if let Some(h) = &entry.high_limit {
+        facts.push(format!("High limit: {}", literal(h)));
+    }
+    if !facts.is_empty() {
+        doc.para(facts.join(". ") + ".");
+    }
+    doc.origin(&entry.origin);
+    doc
+}
+
+fn default_tokens(entry: &Entry, plan: &Plan, value_ty: &TokenStream) -> Option<TokenStream> {
+    let literal = entry.default.as_ref()?;
+    if literal.plus_node_id {
+        return None;
+    }
+    let raw = match plan {
+        Plan::Prim(p) => *p,
+        Plan::Bytes(_) => return None,
+        Plan::Error(_) | Plan::Enum { .. } | Plan::Bits { .. } | Plan::Scaled { .. } => {
+            let raw_prim = Prim::of(entry.data_type)?;
+            let lit = raw_literal(&literal.value, raw_prim)?;
+            let conv = match plan {
+                Plan::Error(_) => quote!(from_code),
+                _ => quote!(from_raw),
+            };
+            return Some(quote!(#value_ty::#conv(#lit)));
+        }
+    };
+    raw_literal(&literal.value, raw)
+}
+
+fn raw_literal(value: &Value, raw: Prim) -> Option<TokenStream> {
+    match (value, raw) {
+        (Value::Integer(v), Prim::Bool) => match v {
+            0 => Some(quote!(false)),
+            1 => Some(quote!(true)),
+            _ => None,
+        },
+        (Value::Integer(v), p) if p.is_integer() => {
+            let (low, high) = p.range();
+            (low..=high).contains(v).then(|| p.lit(*v))
+        }
+        (Value::Real(f), Prim::F32 | Prim::F64) if f.is_finite() => {
+            let lit = proc_macro2::Literal::f64_unsuffixed(f.abs());
+            Some(if *f < 0.0 { quote!(-#lit) } else { quote!(#lit) })
+        }
+        (Value::Integer(v), Prim::F32 | Prim::F64) if v.unsigned_abs() < (1 << 53) => {
+            let lit = proc_macro2::Literal::f64_unsuffixed(v.unsigned_abs() as f64);
+            Some(if *v < 0 { quote!(-#lit) } else { quote!(#lit) })
+        }
+        _ => None,
+    }
+}
+
+fn access_tokens(rt: &TokenStream, access: Access) -> TokenStream {
+    match access {
+        Access::Ro => quote!(#rt::od::access::Ro),
+        Access::Wo => quote!(#rt::od::access::Wo),
+        Access::Rw => quote!(#rt::od::access::Rw),
+        Access::Rwr => quote!(#rt::od::access::Rwr),
+        Access::Rww => quote!(#rt::od::access::Rww),
+        Access::Const => quote!(#rt::od::access::Const),
+    }
+}
+
+fn data_type_tokens(rt: &TokenStream, data_type: DataType) -> TokenStream {
+    use DataType::*;
+    let variant = match data_type {
+        Boolean => quote!(Boolean),
+        Integer8 => quote!(Integer8),
+        Integer16 => quote!(Integer16),
+        Integer24 => quote!(Integer24),
+        Integer32 => quote!(Integer32),
+        Integer40 => quote!(Integer40),
+        Integer48 => quote!(Integer48),
+        Integer56 => quote!(Integer56),
+        Integer64 => quote!(Integer64),
+        Unsigned8 => quote!(Unsigned8),
+        Unsigned16 => quote!(Unsigned16),
+        Unsigned24 => quote!(Unsigned24),
+        Unsigned32 => quote!(Unsigned32),
+        Unsigned40 => quote!(Unsigned40),
+        Unsigned48 => quote!(Unsigned48),
+        Unsigned56 => quote!(Unsigned56),
+        Unsigned64 => quote!(Unsigned64),
+        Real32 => quote!(Real32),
+        Real64 => quote!(Real64),
+        VisibleString => quote!(VisibleString),
+        OctetString => quote!(OctetString),
+        UnicodeString => quote!(UnicodeString),
+        TimeOfDay => quote!(TimeOfDay),
+        TimeDifference => quote!(TimeDifference),
+        Domain => quote!(Domain),
+        Other(code) => {
+            let code = super::prim::hex(u128::from(code));
+            quote!(Other(#code))
+        }
+    };
+    quote!(#rt::od::DataType::#variant)
+}

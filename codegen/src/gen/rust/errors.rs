@@ -1,0 +1,211 @@
+//! Error-code enums: one per device error table, with the source's texts.
+
+use proc_macro2::{Ident, TokenStream};
+use quote::quote;
+
+use super::docs::{self, Doc};
+use super::naming::{Case, Namespace};
+use super::prim::{self, Prim};
+use crate::diag::Diagnostics;
+use crate::ir::{Device, ErrorTable, ErrorTableKind};
+
+/// The generated enum of one error table.
+pub(crate) struct ErrorPlan {
+    pub(crate) table: usize,
+    pub(crate) ident: Ident,
+    /// The code type: wide enough for every code and every entry that
+    /// refers to the table.
+    pub(crate) raw: Prim,
+}
+
+/// Names the enums (in module `errors`) and sizes their code types.
+pub(crate) fn plan(device: &Device, diags: &mut Diagnostics) -> Vec<ErrorPlan> {
+    let mut ns = Namespace::new("module `errors`", Case::UpperCamel);
+    let ids: Vec<_> = device
+        .error_tables
+        .iter()
+        .map(|t| ns.request(&t.name, "table", Some(&t.origin)))
+        .collect();
+    let names = ns.resolve(diags);
+    device
+        .error_tables
+        .iter()
+        .enumerate()
+        .zip(ids)
+        .map(|((i, table), id)| {
+            let mut bits = match table.kind {
+                ErrorTableKind::Emcy => 16,
+                ErrorTableKind::SdoAbort => 32,
+                ErrorTableKind::Device => 8,
+            };
+            let widest_code = table.codes.iter().map(|c| c.code).max().unwrap_or(0);
+            bits = bits.max(32 - widest_code.leading_zeros());
+            for object in device.objects.values() {
+                for entry in object.entries.values() {
+                    if entry.semantics.error_table.as_deref() == Some(table.name.as_str())
+                        && let Some(p) = Prim::of(entry.data_type).filter(|p| p.is_integer())
+                    {
+                        bits = bits.max(match p.unsigned() {
+                            Prim::U8 => 8,
+                            Prim::U16 => 16,
+                            Prim::U32 => 32,
+                            _ => 64,
+                        });
+                    }
+                }
+            }
+            ErrorPlan {
+                table: i,
+                ident: names.get(id),
+                raw: Prim::int(false, bits),
+            }
+        })
+        .collect()
+}
+
+/// The `errors` module's items.
+pub(crate) fn emit(device: &Device, plans: &[ErrorPlan], rt: &TokenStream, diags: &mut Diagnostics) -> TokenStream {
+    let mut out = TokenStream::new();
+    for plan in plans {
+        out.extend(emit_table(&device.error_tables[plan.table], plan, rt, diags));
+    }
+    out
+}
+
+fn emit_table(table: &ErrorTable, plan: &ErrorPlan, rt: &TokenStream, diags: &mut Diagnostics) -> TokenStream {
+    let name = &plan.ident;
+    let ty = plan.raw.tokens();
+    let mut ns = Namespace::new(format!("enum `errors::{name}`"), Case::UpperCamel);
+    ns.reserve("Unknown");
+    let ids: Vec<_> = table
+        .codes
+        .iter()
+        .map(|c| ns.request(&c.name, &format!("code {:#X}", c.code), Some(&c.origin)))
+        .collect();
+    let names = ns.resolve(diags);
+    let mut defs = Vec::new();
+    let mut from_arms = Vec::new();
+    let mut to_arms = Vec::new();
+    let mut name_arms = Vec::new();
+    let mut text_arms = Vec::new();
+    let mut reaction_arms = Vec::new();
+    let mut remedy_arms = Vec::new();
+    for (code, id) in table.codes.iter().zip(&ids) {
+        let v = names.get(*id);
+        let lit = prim::hex(u128::from(code.code));
+        let mut doc = Doc::new();
+        doc.para(format!("**{:#X}** {}", code.code, docs::text(&code.name)));
+        if let Some(text) = &code.text {
+            doc.source_para(text);
+        }
+        if let Some(reaction) = &code.reaction {
+            doc.para(format!("Reaction: {}", docs::text(reaction)));
+        }
+        if let Some(remedy) = &code.remedy {
+            doc.para(format!("Remedy: {}", docs::text(remedy)));
+        }
+        doc.origin(&code.origin);
+        let doc = doc.tokens_with_alias(&code.name, names.text(*id));
+        defs.push(quote!(#doc #v));
+        from_arms.push(quote!(#lit => Self::#v));
+        to_arms.push(quote!(Self::#v => #lit));
+        let source = &code.name;
+        name_arms.push(quote!(Self::#v => #source));
+        let text = code.text.as_deref().unwrap_or(&code.name);
+        text_arms.push(quote!(Self::#v => #text));
+        if let Some(reaction) = &code.reaction {
+            reaction_arms.push(quote!(Self::#v => Some(#reaction)));
+        }
+        if let Some(remedy) = &code.remedy {
+            remedy_arms.push(quote!(Self::#v => Some(#remedy)));
+        }
+    }
+    let kind = match table.kind {
+        ErrorTableKind::Emcy => "EMCY error codes",
+        ErrorTableKind::Device => "device error codes",
+        ErrorTableKind::SdoAbort => "SDO abort codes",
+    };
+    let mut doc = Doc::new();
+    doc.para(format!("**{}**: {kind}.", docs::text(&table.name)));
+    if let Some(description) = &table.description {
+        doc.source_para(description);
+    }
+    doc.origin(&table.origin);
+    let doc = doc.tokens_with_alias(&table.name, &name.to_string());
+    let optional = |arms: &[TokenStream]| {
+        if arms.is_empty() {
+            quote!(None)
+        } else {
+            quote!(match self { #(#arms,)* _ => None })
+        }
+    };
+    let reaction = optional(&reaction_arms);
+    let remedy = optional(&remedy_arms);
+    let scalar = super::values::scalar_impl(rt, name, plan.raw);
+    let display_width = match plan.raw {
+        Prim::U8 => 2usize,
+        Prim::U16 => 4,
+        _ => 8,
+    };
+    quote! {
+        #doc
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub enum #name {
+            #(#defs,)*
+            #[doc = " A code the table does not list."]
+            Unknown(#ty),
+        }
+        impl #name {
+            #[doc = " The meaning of a code; every code has one."]
+            pub const fn from_code(code: #ty) -> Self {
+                match code {
+                    #(#from_arms,)*
+                    other => Self::Unknown(other),
+                }
+            }
+            #[doc = " The code on the bus."]
+            pub const fn code(self) -> #ty {
+                match self {
+                    #(#to_arms,)*
+                    Self::Unknown(code) => code,
+                }
+            }
+            #[doc = " The same as [`Self::from_code`]."]
+            pub const fn from_raw(raw: #ty) -> Self {
+                Self::from_code(raw)
+            }
+            #[doc = " The same as [`Self::code`]."]
+            pub const fn to_raw(self) -> #ty {
+                self.code()
+            }
+            #[doc = " The code's name in the source (`\"unknown\"` for an unlisted code)."]
+            pub const fn name(self) -> &'static str {
+                match self {
+                    #(#name_arms,)*
+                    Self::Unknown(_) => "unknown",
+                }
+            }
+            #[doc = " The source's text for the code (its name when there is none)."]
+            pub const fn text(self) -> &'static str {
+                match self {
+                    #(#text_arms,)*
+                    Self::Unknown(_) => "code not listed in the error table",
+                }
+            }
+            #[doc = " What the device does, as the source says."]
+            pub const fn reaction(self) -> Option<&'static str> {
+                #reaction
+            }
+            #[doc = " What to do about it, as the source says."]
+            pub const fn remedy(self) -> Option<&'static str> {
+                #remedy
+            }
+        }
+        impl core::fmt::Display for #name {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                write!(f, "{:#0width$X} {}", self.code(), self.text(), width = #display_width + 2)
+            }
+        }
+        #scalar
+    }
+}

@@ -1,0 +1,340 @@
+//! The naming table: every generated identifier comes from here.
+//!
+//! Source names (EDS `ParameterName`, YAML `name`) are free text. They are
+//! sanitised into the case Rust expects for the kind of item (German umlauts
+//! transliterated, other non-ASCII and punctuation taken as word breaks,
+//! a leading digit prefixed, keywords suffixed with `_`). A [`Namespace`]
+//! collects every name requested in one scope first and then resolves them
+//! together: names that become equal after sanitising are all qualified with
+//! their key (index, subindex, code) and reported as one diagnostic naming
+//! both origins, so that adding an object never silently renames another.
+
+use std::collections::BTreeMap;
+
+use heck::{ToShoutySnakeCase, ToSnakeCase, ToUpperCamelCase};
+use proc_macro2::{Ident, Span};
+
+use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
+use crate::ir::Origin;
+
+/// The case of a kind of identifier.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Case {
+    /// Types, enum variants.
+    UpperCamel,
+    /// Modules, fields, functions.
+    Snake,
+    /// Constants.
+    ShoutySnake,
+}
+
+/// Rust's strict and reserved keywords (edition 2024) plus the names that
+/// cannot be raw identifiers.
+const KEYWORDS: &[&str] = &[
+    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum", "extern",
+    "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut",
+    "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true", "type",
+    "unsafe", "use", "where", "while", "abstract", "become", "box", "do", "final", "macro",
+    "override", "priv", "try", "typeof", "unsized", "virtual", "yield", "union", "macro_rules",
+    "raw", "safe",
+];
+
+/// `text` as an identifier of `case`, or `""` when nothing usable remains.
+pub(crate) fn sanitize(text: &str, case: Case) -> String {
+    let mut ascii = String::with_capacity(text.len());
+    for c in text.chars() {
+        match c {
+            'a'..='z' | 'A'..='Z' | '0'..='9' => ascii.push(c),
+            'ä' => ascii.push_str("ae"),
+            'ö' => ascii.push_str("oe"),
+            'ü' => ascii.push_str("ue"),
+            'Ä' => ascii.push_str("Ae"),
+            'Ö' => ascii.push_str("Oe"),
+            'Ü' => ascii.push_str("Ue"),
+            'ß' => ascii.push_str("ss"),
+            _ => ascii.push(' '),
+        }
+    }
+    let mut name = match case {
+        Case::UpperCamel => ascii.to_upper_camel_case(),
+        Case::Snake => ascii.to_snake_case(),
+        Case::ShoutySnake => ascii.to_shouty_snake_case(),
+    };
+    if name.is_empty() {
+        return name;
+    }
+    if name.starts_with(|c: char| c.is_ascii_digit()) {
+        name.insert_str(
+            0,
+            match case {
+                Case::UpperCamel => "N",
+                Case::Snake => "n_",
+                Case::ShoutySnake => "N_",
+            },
+        );
+    }
+    if KEYWORDS.contains(&name.as_str()) {
+        name.push('_');
+    }
+    name
+}
+
+/// The identifier for an already sanitised name.
+pub(crate) fn ident(name: &str) -> Ident {
+    Ident::new(name, Span::call_site())
+}
+
+/// Whether rustdoc accepts `source` as `#[doc(alias)]` of an item called
+/// `ident` (no quotes, no whitespace but spaces, none at the ends, not the
+/// item's own name).
+pub(crate) fn alias_allowed(source: &str, ident: &str) -> bool {
+    !source.is_empty()
+        && source != ident
+        && !source.starts_with(' ')
+        && !source.ends_with(' ')
+        && !source
+            .chars()
+            .any(|c| c == '"' || c == '\'' || (c.is_whitespace() && c != ' ') || c.is_control())
+}
+
+/// A handle to a requested name; resolved by [`Names::get`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct NameId(usize);
+
+struct Request {
+    base: String,
+    key: String,
+    source: String,
+    origin: Option<Origin>,
+}
+
+/// One scope of generated names (a module, an enum's variants, a struct's
+/// fields, an impl's methods).
+pub(crate) struct Namespace {
+    scope: String,
+    case: Case,
+    reserved: Vec<String>,
+    requests: Vec<Request>,
+}
+
+/// The resolved names of a [`Namespace`].
+pub(crate) struct Names {
+    names: Vec<String>,
+}
+
+impl Names {
+    pub(crate) fn get(&self, id: NameId) -> Ident {
+        ident(&self.names[id.0])
+    }
+
+    pub(crate) fn text(&self, id: NameId) -> &str {
+        &self.names[id.0]
+    }
+}
+
+impl Namespace {
+    /// `scope` says where the names live, for diagnostics ("module `od`").
+    pub(crate) fn new(scope: impl Into<String>, case: Case) -> Namespace {
+        Namespace {
+            scope: scope.into(),
+            case,
+            reserved: Vec::new(),
+            requests: Vec::new(),
+        }
+    }
+
+    /// A name the generator itself uses in this scope (a method, a fixed
+    /// variant); a source name that becomes equal to it is qualified.
+    pub(crate) fn reserve(&mut self, name: &str) {
+        self.reserved.push(name.to_string());
+    }
+
+    /// Requests a name for `source`; `key` tells it apart from others when
+    /// needed (`x2001`, `sub 3`, `code 0x10`) and names it when the source
+    /// name has nothing usable.
+    pub(crate) fn request(
+        &mut self,
+        source: &str,
+        key: &str,
+        origin: Option<&Origin>,
+    ) -> NameId {
+        self.requests.push(Request {
+            base: sanitize(source, self.case),
+            key: key.to_string(),
+            source: source.to_string(),
+            origin: origin.cloned(),
+        });
+        NameId(self.requests.len() - 1)
+    }
+
+    /// Resolves every request; collisions are reported into `diags`.
+    pub(crate) fn resolve(self, diags: &mut Diagnostics) -> Names {
+        let case = self.case;
+        let qualified = |r: &Request| sanitize(&format!("{} {}", r.base, r.key), case);
+        let mut groups: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
+        for (i, r) in self.requests.iter().enumerate() {
+            if !r.base.is_empty() {
+                groups.entry(r.base.as_str()).or_default().push(i);
+            }
+        }
+        let mut names: Vec<String> = Vec::with_capacity(self.requests.len());
+        for r in &self.requests {
+            if r.base.is_empty() {
+                names.push(qualified(r));
+                continue;
+            }
+            let group = &groups[r.base.as_str()];
+            let clash_reserved = self.reserved.iter().any(|n| *n == r.base);
+            names.push(if group.len() > 1 || clash_reserved {
+                qualified(r)
+            } else {
+                r.base.clone()
+            });
+        }
+        for (base, members) in &groups {
+            let clash_reserved = self.reserved.iter().any(|n| n == base);
+            if members.len() > 1 {
+                let renamed: Vec<&str> = members.iter().map(|&i| names[i].as_str()).collect();
+                report(diags, &self.scope, base, members, &self.requests, &renamed);
+            } else if clash_reserved {
+                let r = &self.requests[members[0]];
+                diags.push(diagnostic(
+                    r.origin.as_ref(),
+                    format!(
+                        "`{}` becomes `{base}` in {}, a name the generator uses there; it is named `{}`",
+                        r.source, self.scope, names[members[0]]
+                    ),
+                    Vec::new(),
+                ));
+            }
+        }
+        // Qualified names may still meet each other or a reserved name:
+        // number them, in request order.
+        let mut taken: Vec<String> = self.reserved.clone();
+        for name in &mut names {
+            if taken.contains(name) {
+                let mut n = 2;
+                while taken.contains(&format!("{name}{}{n}", sep(case))) {
+                    n += 1;
+                }
+                *name = format!("{name}{}{n}", sep(case));
+            }
+            taken.push(name.clone());
+        }
+        Names { names }
+    }
+}
+
+fn sep(case: Case) -> &'static str {
+    match case {
+        Case::UpperCamel => "",
+        Case::Snake | Case::ShoutySnake => "_",
+    }
+}
+
+fn report(
+    diags: &mut Diagnostics,
+    scope: &str,
+    base: &str,
+    members: &[usize],
+    requests: &[Request],
+    renamed: &[&str],
+) {
+    let first = &requests[members[0]];
+    let mut notes = Vec::new();
+    for (&i, name) in members.iter().zip(renamed) {
+        let r = &requests[i];
+        notes.push(format!("`{}` at {} is named `{name}`", r.source, at(r.origin.as_ref())));
+    }
+    let others: Vec<String> = members[1..]
+        .iter()
+        .map(|&i| {
+            let r = &requests[i];
+            format!("`{}` ({})", r.source, at(r.origin.as_ref()))
+        })
+        .collect();
+    diags.push(diagnostic(
+        first.origin.as_ref(),
+        format!(
+            "`{}` ({}) and {} all become `{base}` in {scope}; each is qualified with its key",
+            first.source,
+            at(first.origin.as_ref()),
+            others.join(" and "),
+        ),
+        notes,
+    ));
+}
+
+fn at(origin: Option<&Origin>) -> String {
+    match origin {
+        Some(o) if o.line > 0 => format!("{}:{}", o.file, o.line),
+        Some(o) => o.file.clone(),
+        None => "generated".into(),
+    }
+}
+
+fn diagnostic(origin: Option<&Origin>, message: String, notes: Vec<String>) -> Diagnostic {
+    Diagnostic {
+        severity: Severity::Warning,
+        code: "gen::name-collision",
+        file: origin.map(|o| o.file.clone()).unwrap_or_default(),
+        location: Location {
+            line: origin.map(|o| o.line).filter(|&l| l > 0),
+            ..Location::default()
+        },
+        message,
+        notes,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sanitising() {
+        assert_eq!(sanitize("Motor-Temperatur (°C)", Case::UpperCamel), "MotorTemperaturC");
+        assert_eq!(sanitize("Größe über", Case::Snake), "groesse_ueber");
+        assert_eq!(sanitize("1st value", Case::Snake), "n_1st_value");
+        assert_eq!(sanitize("1st value", Case::UpperCamel), "N1stValue");
+        assert_eq!(sanitize("type", Case::Snake), "type_");
+        assert_eq!(sanitize("self", Case::Snake), "self_");
+        assert_eq!(sanitize("Self", Case::UpperCamel), "Self_");
+        assert_eq!(sanitize("\"]; } 🚀", Case::Snake), "");
+        assert_eq!(sanitize("max speed", Case::ShoutySnake), "MAX_SPEED");
+    }
+
+    #[test]
+    fn collisions_are_qualified_and_reported() {
+        let o = |line| Origin {
+            file: "a.eds".into(),
+            line,
+        };
+        let mut ns = Namespace::new("module `od`", Case::UpperCamel);
+        ns.reserve("Unknown");
+        let a = ns.request("Reserved", "x2001", Some(&o(10)));
+        let b = ns.request("reserved!", "x2002", Some(&o(20)));
+        let c = ns.request("Speed", "x2003", Some(&o(30)));
+        let d = ns.request("unknown", "x2004", Some(&o(40)));
+        let e = ns.request("🚀", "x2005", Some(&o(50)));
+        let mut diags = Diagnostics::new();
+        let names = ns.resolve(&mut diags);
+        assert_eq!(names.text(a), "ReservedX2001");
+        assert_eq!(names.text(b), "ReservedX2002");
+        assert_eq!(names.text(c), "Speed");
+        assert_eq!(names.text(d), "UnknownX2004");
+        assert_eq!(names.text(e), "X2005");
+        assert_eq!(diags.len(), 2);
+        let text = diags.to_string();
+        assert!(text.contains("a.eds:10") && text.contains("a.eds:20"), "{text}");
+    }
+
+    #[test]
+    fn aliases() {
+        assert!(alias_allowed("Motor speed", "MotorSpeed"));
+        assert!(!alias_allowed("Speed", "Speed"));
+        assert!(!alias_allowed("say \"hi\"", "SayHi"));
+        assert!(!alias_allowed(" x", "X"));
+        assert!(!alias_allowed("a\tb", "AB"));
+    }
+}

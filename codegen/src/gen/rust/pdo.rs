@@ -1,0 +1,407 @@
+//! The `pdo` module: one struct per default PDO mapping, with `encode` into a
+//! fixed array and `decode` from a slice by shifts and masks at the offsets
+//! the mapping gives (any bit offset, widths 1–64, sign extension), COB-ID
+//! helpers per node id, and the runtime's `Pdo` trait.
+
+use std::collections::BTreeMap;
+
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use super::docs::{self, Doc};
+use super::entries::EntryInfo;
+use super::naming::{Case, NameId, Namespace};
+use super::prim::{self, Prim};
+use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
+use crate::ir::pdo::{MappedObject, MappingProblem, check_entry, is_mapping_object, raw_mapping};
+use crate::ir::{DataType, Device, Object, PdoDirection, Value};
+
+/// One field of a PDO: a mapped entry at a bit offset.
+struct Field<'a> {
+    target: MappedObject,
+    offset: u32,
+    width: u32,
+    info: &'a EntryInfo,
+    raw: Prim,
+    entry_name: &'a str,
+    data_type: DataType,
+    name: NameId,
+}
+
+struct Layout<'a> {
+    mapping: &'a Object,
+    direction: PdoDirection,
+    number: u16,
+    fields: Vec<Field<'a>>,
+    gaps: Vec<(u32, u32, DataType)>,
+    total: u32,
+}
+
+/// The `pdo` module's items (empty when the device has no default PDO).
+pub(crate) fn emit(
+    device: &Device,
+    infos: &BTreeMap<(u16, u8), EntryInfo>,
+    rt: &TokenStream,
+    diags: &mut Diagnostics,
+) -> TokenStream {
+    let mut structs = Namespace::new("module `pdo`", Case::UpperCamel);
+    let mut planned = Vec::new();
+    for mapping in device.objects.values().filter(|o| is_mapping_object(o.index)) {
+        let Some((layout, fields_ns)) = layout(device, mapping, infos, diags) else {
+            continue;
+        };
+        let label = device
+            .pdo_labels
+            .iter()
+            .find(|l| l.direction == layout.direction && l.number == layout.number);
+        let prefix = match layout.direction {
+            PdoDirection::Rpdo => "rpdo",
+            PdoDirection::Tpdo => "tpdo",
+        };
+        let source = match label {
+            Some(label) => format!("{prefix}{} {}", layout.number, label.name),
+            None => format!("{prefix}{}", layout.number),
+        };
+        let id = structs.request(&source, &format!("x{:04X}", mapping.index), Some(&mapping.origin));
+        planned.push((layout, fields_ns, label, id));
+    }
+    let names = structs.resolve(diags);
+    let mut out = TokenStream::new();
+    for (layout, fields_ns, label, id) in planned {
+        let field_names = fields_ns.resolve(diags);
+        let ident = names.get(id);
+        out.extend(emit_struct(device, &layout, &ident, label, &field_names, rt));
+    }
+    out
+}
+
+fn warn(diags: &mut Diagnostics, mapping: &Object, message: String) {
+    diags.push(Diagnostic {
+        severity: Severity::Warning,
+        code: "gen::pdo-skipped",
+        file: mapping.origin.file.clone(),
+        location: Location {
+            line: Some(mapping.origin.line).filter(|&l| l > 0),
+            ..Location::default()
+        },
+        message,
+        notes: Vec::new(),
+    });
+}
+
+fn layout<'a>(
+    device: &'a Device,
+    mapping: &'a Object,
+    infos: &'a BTreeMap<(u16, u8), EntryInfo>,
+    diags: &mut Diagnostics,
+) -> Option<(Layout<'a>, Namespace)> {
+    let (direction, number) = if mapping.index >= 0x1A00 {
+        (PdoDirection::Tpdo, mapping.index - 0x1A00 + 1)
+    } else {
+        (PdoDirection::Rpdo, mapping.index - 0x1600 + 1)
+    };
+    let count = mapping.entries.get(&0).and_then(raw_mapping).unwrap_or(u32::MAX);
+    let name = format!("{direction:?}{number}").to_uppercase();
+    let mut fields_ns = Namespace::new(format!("struct of {name} (0x{:04X})", mapping.index), Case::Snake);
+    let mut fields = Vec::new();
+    let mut gaps = Vec::new();
+    let mut offset = 0u32;
+    for entry in mapping.entries.values().filter(|e| e.subindex >= 1 && u32::from(e.subindex) <= count) {
+        let Some(raw) = raw_mapping(entry).filter(|&r| r != 0) else {
+            continue;
+        };
+        let target = MappedObject::from_raw(raw);
+        let width = u32::from(target.bits);
+        let problems = check_entry(device, raw);
+        let fatal: Vec<&MappingProblem> = problems
+            .iter()
+            .filter(|p| !matches!(p, MappingProblem::NotMappable { .. }))
+            .collect();
+        if let Some(problem) = fatal.first() {
+            warn(diags, mapping, format!("{name} is not generated: sub {} {problem}", entry.subindex));
+            return None;
+        }
+        if width == 0 {
+            warn(diags, mapping, format!("{name} is not generated: sub {} maps 0 bits", entry.subindex));
+            return None;
+        }
+        if target.is_dummy() {
+            gaps.push((offset, width, DataType::from_code(target.index)));
+            offset += width;
+            continue;
+        }
+        let Some(info) = infos.get(&(target.index, target.subindex)) else {
+            warn(diags, mapping, format!("{name} is not generated: 0x{:04X} sub {} has no generated type", target.index, target.subindex));
+            return None;
+        };
+        let Some(raw_prim) = info.raw else {
+            warn(diags, mapping, format!("{name} is not generated: 0x{:04X} sub {} has no fixed size", target.index, target.subindex));
+            return None;
+        };
+        let object = &device.objects[&target.index];
+        let mapped = &object.entries[&target.subindex];
+        let source = if matches!(object.kind, crate::ir::ObjectKind::Var | crate::ir::ObjectKind::Domain) {
+            &object.name
+        } else {
+            &mapped.name
+        };
+        let name_id = fields_ns.request(source, &format!("x{:04X} sub {}", target.index, target.subindex), Some(&mapped.origin));
+        fields.push(Field {
+            target,
+            offset,
+            width,
+            info,
+            raw: raw_prim,
+            entry_name: source,
+            data_type: mapped.data_type,
+            name: name_id,
+        });
+        offset += width;
+    }
+    if offset > 64 {
+        warn(diags, mapping, format!("{name} is not generated: its mapping totals {offset} bits; a PDO carries at most 64"));
+        return None;
+    }
+    if fields.is_empty() {
+        return None;
+    }
+    Some((
+        Layout {
+            mapping,
+            direction,
+            number,
+            fields,
+            gaps,
+            total: offset,
+        },
+        fields_ns,
+    ))
+}
+
+fn span_text(offset: u32, width: u32) -> (String, String) {
+    let last = offset + width - 1;
+    let bits = if width == 1 { offset.to_string() } else { format!("{offset}–{last}") };
+    let bytes = if offset % 8 == 0 && width % 8 == 0 {
+        if width == 8 { (offset / 8).to_string() } else { format!("{}–{}", offset / 8, last / 8) }
+    } else {
+        format!("{}.{}–{}.{}", offset / 8, offset % 8, last / 8, last % 8)
+    };
+    (bits, bytes)
+}
+
+fn emit_struct(
+    device: &Device,
+    layout: &Layout,
+    ident: &proc_macro2::Ident,
+    label: Option<&crate::ir::PdoLabel>,
+    names: &super::naming::Names,
+    rt: &TokenStream,
+) -> TokenStream {
+    let len = layout.total.div_ceil(8) as usize;
+    let len_lit = Literal::usize_unsuffixed(len);
+    let (kind, direction) = match layout.direction {
+        PdoDirection::Rpdo => ("RPDO", quote!(#rt::od::PdoDirection::Rpdo)),
+        PdoDirection::Tpdo => ("TPDO", quote!(#rt::od::PdoDirection::Tpdo)),
+    };
+    let comm_index = layout.direction.communication_index(layout.number);
+    let mut doc = Doc::new();
+    let title = match label {
+        Some(l) => format!("**{kind}{} {}**", layout.number, docs::text(&l.name)),
+        None => format!("**{kind}{}**", layout.number),
+    };
+    doc.para(format!(
+        "{title}: {len} data bytes, mapping 0x{:04X}, communication parameters 0x{comm_index:04X}.",
+        layout.mapping.index
+    ));
+    if let Some(description) = label.and_then(|l| l.description.as_deref()) {
+        doc.source_para(description);
+    }
+    let comm = device.objects.get(&comm_index);
+    let comm_default = |sub: u8| comm.and_then(|o| o.entries.get(&sub)).and_then(|e| e.default.as_ref());
+    let mut facts = Vec::new();
+    if let Some(t) = comm_default(2) {
+        facts.push(format!("transmission type {}", docs::text(&t.text)));
+    }
+    if let Some(t) = comm_default(5).filter(|_| layout.direction == PdoDirection::Tpdo) {
+        facts.push(format!("event timer {} ms", docs::text(&t.text)));
+    }
+    if !facts.is_empty() {
+        doc.para(format!("Defaults: {}.", facts.join(", ")));
+    }
+    doc.para("| Bits | Bytes | Field | Object | Type |");
+    doc.line("|---|---|---|---|---|");
+    let mut rows: Vec<(u32, String)> = Vec::new();
+    for f in &layout.fields {
+        let (bits, bytes) = span_text(f.offset, f.width);
+        rows.push((f.offset, format!(
+            "| {bits} | {bytes} | `{}` | 0x{:04X} sub {} {} | {} |",
+            names.text(f.name), f.target.index, f.target.subindex, docs::text(f.entry_name), f.data_type.name()
+        )));
+    }
+    for &(offset, width, data_type) in &layout.gaps {
+        let (bits, bytes) = span_text(offset, width);
+        rows.push((offset, format!("| {bits} | {bytes} | (gap) | dummy | {} |", data_type.name())));
+    }
+    rows.sort();
+    for (_, row) in rows {
+        doc.line(row);
+    }
+    doc.origin(&layout.mapping.origin);
+    let doc = match label {
+        Some(l) => doc.tokens_with_alias(&l.name, &ident.to_string()),
+        None => doc.tokens(),
+    };
+
+    let mut defs = Vec::new();
+    let mut decodes = Vec::new();
+    let mut encodes = Vec::new();
+    let mut float = false;
+    for f in &layout.fields {
+        let name = names.get(f.name);
+        let ty = f.info.value_tokens(1);
+        float |= f.raw.is_float();
+        let (bits, bytes) = span_text(f.offset, f.width);
+        let field_doc = format!(" **{}** (0x{:04X} sub {}): bits {bits}, bytes {bytes}.", docs::text(f.entry_name), f.target.index, f.target.subindex);
+        defs.push(quote!(#[doc = #field_doc] pub #name: #ty));
+        let mask = if f.width == 64 { u64::MAX } else { (1u64 << f.width) - 1 };
+        let mask_lit = prim::hex(u128::from(mask));
+        let shift = Literal::u32_unsuffixed(f.offset);
+        let needs_mask = f.offset + f.width < 64;
+        let extract = match (f.offset == 0, needs_mask) {
+            (true, false) => quote!(word),
+            (true, true) => quote!((word & #mask_lit)),
+            (false, false) => quote!((word >> #shift)),
+            (false, true) => quote!((word >> #shift & #mask_lit)),
+        };
+        let raw_expr = prim::from_bits(f.raw, extract, f.width);
+        decodes.push(match &f.info.value {
+            Some(_) => quote!(#name: #ty::from_raw(#raw_expr)),
+            None => quote!(#name: #raw_expr),
+        });
+        let value = match &f.info.value {
+            Some(_) => quote!(self.#name.to_raw()),
+            None => quote!(self.#name),
+        };
+        let bits_expr = prim::to_bits(f.raw, value);
+        let prim_bits = match f.raw {
+            Prim::Bool => 1,
+            Prim::U8 => 8,
+            Prim::U16 => 16,
+            Prim::U32 => 32,
+            _ => 64,
+        };
+        let masked = f.width < 64 && (f.raw.is_signed() || f.raw.is_float() || prim_bits > f.width);
+        encodes.push(match (f.offset == 0, masked) {
+            (true, false) => quote!(word |= #bits_expr;),
+            (true, true) => quote!(word |= #bits_expr & #mask_lit;),
+            (false, false) => quote!(word |= (#bits_expr) << #shift;),
+            (false, true) => quote!(word |= (#bits_expr & #mask_lit) << #shift;),
+        });
+    }
+    let byte_idx: Vec<Literal> = (0..len).map(Literal::usize_unsuffixed).collect();
+    let zeros = (len..8).map(|_| quote!(0));
+    let word_from_bytes = if len == 8 {
+        quote!(u64::from_le_bytes(bytes))
+    } else {
+        quote!(u64::from_le_bytes([#(bytes[#byte_idx],)* #(#zeros,)*]))
+    };
+    let bytes_from_word = if len == 8 {
+        quote!(word.to_le_bytes())
+    } else {
+        quote!(let bytes = word.to_le_bytes(); [#(bytes[#byte_idx],)*])
+    };
+    let derives = if float {
+        quote!(#[derive(Debug, Clone, Copy, PartialEq)])
+    } else {
+        quote!(#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)])
+    };
+    let cob = cob_id_items(comm_default(1), rt);
+    let number = Literal::u16_unsuffixed(layout.number);
+    let comm_lit = prim::hex(u128::from(comm_index));
+    let map_lit = prim::hex(u128::from(layout.mapping.index));
+    let decode_doc = format!(" Decodes the data of a frame; it must be exactly {len} bytes. Never panics.");
+    let encode_doc = format!(" The {len} data bytes of the frame.");
+    let _ = format_ident!("unused");
+    let _ = Value::Integer(0);
+    quote! {
+        #doc
+        #derives
+        pub struct #ident {
+            #(#defs,)*
+        }
+        impl #ident {
+            #[doc = " Data length in bytes."]
+            pub const LEN: usize = #len_lit;
+            #cob
+            #[doc = #decode_doc]
+            pub fn decode(data: &[u8]) -> Result<Self, #rt::od::PdoLengthError> {
+                let Ok(bytes) = <[u8; #len_lit]>::try_from(data) else {
+                    return Err(#rt::od::PdoLengthError { expected: #len_lit, actual: data.len() });
+                };
+                let word = #word_from_bytes;
+                Ok(Self { #(#decodes,)* })
+            }
+            #[doc = #encode_doc]
+            pub fn encode(&self) -> [u8; #len_lit] {
+                let mut word = 0u64;
+                #(#encodes)*
+                #bytes_from_word
+            }
+        }
+        impl #rt::od::Pdo for #ident {
+            const DIRECTION: #rt::od::PdoDirection = #direction;
+            const NUMBER: u16 = #number;
+            const COMMUNICATION_INDEX: u16 = #comm_lit;
+            const MAPPING_INDEX: u16 = #map_lit;
+            const LEN: usize = #len_lit;
+            fn decode(data: &[u8]) -> Result<Self, #rt::od::PdoLengthError> {
+                Self::decode(data)
+            }
+            fn encode_into(&self, out: &mut [u8; 8]) -> usize {
+                for (o, b) in out.iter_mut().zip(self.encode()) {
+                    *o = b;
+                }
+                #len_lit
+            }
+        }
+    }
+}
+
+/// `cob_id(node_id)`/`can_id(node_id)` for a `$NODEID`-relative default,
+/// `COB_ID`/`CAN_ID` for a fixed one, nothing without a default.
+fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> TokenStream {
+    let Some(literal) = default else {
+        return TokenStream::new();
+    };
+    let Value::Integer(value) = literal.value else {
+        return TokenStream::new();
+    };
+    let Ok(value) = u32::try_from(value) else {
+        return TokenStream::new();
+    };
+    let id_mask = if value & (1 << 29) != 0 { 0x1FFF_FFFFu32 } else { 0x7FF };
+    let id_mask = prim::hex(u128::from(id_mask));
+    let value_lit = prim::hex(u128::from(value));
+    let text = docs::text(&literal.text);
+    if literal.plus_node_id {
+        let doc = format!(" The default COB-ID entry value for a node: {text} (bit 31 set means the PDO is disabled).");
+        quote! {
+            #[doc = #doc]
+            pub const fn cob_id(node_id: #rt::od::NodeId) -> u32 {
+                #value_lit + node_id.get() as u32
+            }
+            #[doc = " The CAN identifier of the default COB-ID for a node."]
+            pub const fn can_id(node_id: #rt::od::NodeId) -> u32 {
+                Self::cob_id(node_id) & #id_mask
+            }
+        }
+    } else {
+        let doc = format!(" The default COB-ID entry value, {text} (bit 31 set means the PDO is disabled).");
+        quote! {
+            #[doc = #doc]
+            pub const COB_ID: u32 = #value_lit;
+            #[doc = " The CAN identifier of the default COB-ID."]
+            pub const CAN_ID: u32 = #value_lit & #id_mask;
+        }
+    }
+}
