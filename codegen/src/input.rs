@@ -1,7 +1,7 @@
 //! Reading a device from any input file: EDS/DCF or YAML object table,
 //! chosen by the file name's extension.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use crate::diag::Diagnostics;
 use crate::ir::Device;
@@ -14,11 +14,18 @@ pub struct Options {
 }
 
 /// The result of reading one file: the device (absent only when the file could
-/// not be read at all) and every diagnostic.
+/// not be read at all), every diagnostic, and the files the result depends on.
 #[derive(Debug, Clone)]
 pub struct Loaded {
     pub device: Option<Device>,
     pub diagnostics: Diagnostics,
+    /// Every file read from disk (or tried: a file that could not be read is
+    /// listed too), in reading order, each once: the input itself first,
+    /// then the `base:` EDS of a YAML overlay table. Empty for the
+    /// `read_bytes` readers, which read nothing from disk themselves (but a
+    /// table's `base:` is listed). Build scripts print these as
+    /// `cargo:rerun-if-changed`.
+    pub files: Vec<PathBuf>,
 }
 
 impl Loaded {
@@ -36,7 +43,17 @@ impl Loaded {
         Loaded {
             device: None,
             diagnostics,
+            files: Vec::new(),
         }
+    }
+
+    /// Records that `path` was read (or tried), in front of the files
+    /// already listed, unless it is listed already.
+    pub(crate) fn read_first(mut self, path: &Path) -> Loaded {
+        if !self.files.iter().any(|f| f == path) {
+            self.files.insert(0, path.to_path_buf());
+        }
+        self
     }
 }
 

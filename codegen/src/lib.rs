@@ -7,8 +7,11 @@
 //! - [`ir`]: the object-dictionary model, plain data;
 //! - [`dump`]: IR → JSON for tools and tests;
 //! - `gen` (`r#gen`: `gen` is a reserved word in Rust 2024): IR → files: an EDS (CiA 306) export, product variants applied;
-//! - [`diag`]: diagnostics with file, line, section and key.
+//! - [`diag`]: diagnostics with file, line, section and key;
+//! - [`build`]: the build-script API ([`Builder`], in the shape of
+//!   prost-build) and the pure [`generate`]: input + overlays → Rust source.
 
+pub mod build;
 pub mod diag;
 pub mod dump;
 pub mod eds;
@@ -16,3 +19,5 @@ pub mod r#gen;
 pub mod input;
 pub mod ir;
 pub mod table;
+
+pub use build::{Builder, Error, generate};

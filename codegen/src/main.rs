@@ -1,4 +1,5 @@
-//! The `eds2rust` command line: check and dump CANopen object dictionaries.
+//! The `eds2rust` command line: check, dump, export CANopen object
+//! dictionaries, and generate their Rust.
 //!
 //! Exit status: 0 when no input has an error, 1 when one has, 2 on usage errors.
 
@@ -13,7 +14,7 @@ use eds2rust::input::{Options, read_device};
 #[command(
     name = "eds2rust",
     version,
-    about = "Reads CANopen object dictionaries (EDS/DCF files and YAML object tables) and reports on them"
+    about = "Reads CANopen object dictionaries (EDS/DCF files and YAML object tables), reports on them and generates their Rust"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -59,6 +60,26 @@ enum Command {
         strict: bool,
         file: PathBuf,
     },
+    /// Prints the generated Rust of one device (or writes it with -o).
+    /// Diagnostics go to stderr; nothing is written when there is an error.
+    Generate {
+        /// A YAML overlay table (without `base:`) applied on the input; may
+        /// be given several times, applied in order.
+        #[arg(long = "overlay", value_name = "FILE")]
+        overlays: Vec<PathBuf>,
+        /// The path of the runtime crate in generated code (default
+        /// `::eds2rust_runtime`).
+        #[arg(long, value_name = "PATH")]
+        runtime_path: Option<String>,
+        /// Write here instead of standard output (replaced only when complete).
+        #[arg(long, short)]
+        output: Option<PathBuf>,
+        /// Turn warnings into errors.
+        #[arg(long)]
+        strict: bool,
+        /// An EDS/DCF file or a YAML object table.
+        file: PathBuf,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -92,6 +113,22 @@ fn main() -> ExitCode {
             variant.as_deref(),
             output.as_deref(),
             Options { strict },
+        ),
+        Command::Generate {
+            overlays,
+            runtime_path,
+            output,
+            strict,
+            file,
+        } => generate(
+            &file,
+            &overlays,
+            output.as_deref(),
+            &eds2rust::r#gen::rust::Options {
+                runtime_path: runtime_path
+                    .unwrap_or_else(|| eds2rust::r#gen::rust::Options::default().runtime_path),
+                strict,
+            },
         ),
     }
 }
@@ -169,6 +206,38 @@ fn export(
             }
         },
     };
+    write_output(output, &text)
+}
+
+fn generate(
+    path: &std::path::Path,
+    overlays: &[PathBuf],
+    output: Option<&std::path::Path>,
+    options: &eds2rust::r#gen::rust::Options,
+) -> ExitCode {
+    let generated = eds2rust::build::generate_device(path, overlays, options);
+    let code = match generated.result {
+        Ok(out) => {
+            let _ = write!(std::io::stderr().lock(), "{}", out.warnings.render());
+            out.code
+        }
+        Err(diagnostics) => {
+            let mut err = std::io::stderr().lock();
+            let _ = write!(err, "{}", diagnostics.render());
+            let _ = writeln!(
+                err,
+                "{}: not generated: {} errors",
+                path.display(),
+                diagnostics.error_count()
+            );
+            return ExitCode::from(1);
+        }
+    };
+    write_output(output, &code)
+}
+
+/// Writes `text` to standard output, or whole to `output`.
+fn write_output(output: Option<&std::path::Path>, text: &str) -> ExitCode {
     match output {
         None => {
             let _ = std::io::stdout().lock().write_all(text.as_bytes());

@@ -1,5 +1,5 @@
-//! The `eds2rust` binary: exit codes of `check`, and the `dump --format json`
-//! schema on the repository's example file.
+//! The `eds2rust` binary: exit codes of `check`, the `dump --format json`
+//! schema on the repository's example file, export and generate.
 
 use std::process::Command;
 
@@ -229,4 +229,74 @@ fn yaml_tables_are_checked_dumped_and_exported_like_eds() {
         stderr.contains("ACS40") && stderr.contains("ACS60"),
         "{stderr}"
     );
+}
+
+#[test]
+fn generate_prints_code_or_errors() {
+    let linak = seed("linak_techline");
+    let (code, stdout, stderr) = run(&["generate", &linak]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.starts_with("// @generated"), "{stdout}");
+
+    let dir = tempdir();
+    let out = dir.join("linak.rs");
+    let (code, written, stderr) = run(&[
+        "generate",
+        "--runtime-path",
+        "::my::runtime",
+        "-o",
+        out.to_str().unwrap(),
+        &linak,
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(written.is_empty(), "{written}");
+    assert!(
+        std::fs::read_to_string(&out)
+            .unwrap()
+            .starts_with("// @generated")
+    );
+
+    // An overlay without `base:` on the example EDS.
+    let overlay = dir.join("gen_overlay.yaml");
+    std::fs::write(
+        &overlay,
+        "format: 1\nmodify:\n  - { index: 0x6060, default: 3 }\n",
+    )
+    .unwrap();
+    let (code, stdout, stderr) = run(&[
+        "generate",
+        "--overlay",
+        overlay.to_str().unwrap(),
+        &example(),
+    ]);
+    assert_eq!(code, 0, "{stderr}");
+    assert!(stdout.starts_with("// @generated"), "{stdout}");
+
+    // Errors: exit 1, diagnostics on stderr, nothing on stdout, -o untouched.
+    let bad = dir.join("gen_bad.yaml");
+    std::fs::write(
+        &bad,
+        "format: 1\ndevice: { vendor_name: V, product_name: P }\nobjects:\n  - { index: 0x2000, name: A, type: UINT16, access: rw }\n",
+    )
+    .unwrap();
+    let kept = dir.join("kept.rs");
+    std::fs::write(&kept, "previous").unwrap();
+    for args in [
+        vec!["generate", bad.to_str().unwrap()],
+        vec![
+            "generate",
+            "-o",
+            kept.to_str().unwrap(),
+            bad.to_str().unwrap(),
+        ],
+        vec!["generate", "--overlay", bad.to_str().unwrap(), &example()],
+    ] {
+        let (code, stdout, stderr) = run(&args);
+        assert_eq!(code, 1, "{args:?}: {stderr}");
+        assert!(stdout.is_empty(), "{stdout}");
+        assert!(stderr.contains("gen_bad.yaml:"), "{stderr}");
+    }
+    assert_eq!(std::fs::read_to_string(&kept).unwrap(), "previous");
+
+    assert_eq!(run(&["generate"]).0, 2, "no input is a usage error");
 }

@@ -66,7 +66,14 @@ impl DataType {
         use DataType::*;
         matches!(
             self,
-            Integer8 | Integer16 | Integer24 | Integer32 | Integer40 | Integer48 | Integer56 | Integer64
+            Integer8
+                | Integer16
+                | Integer24
+                | Integer32
+                | Integer40
+                | Integer48
+                | Integer56
+                | Integer64
         )
     }
 }

@@ -24,6 +24,7 @@ pub fn read_file(path: &Path, options: Options) -> Loaded {
         Ok(bytes) => read_bytes(&name, &bytes, options),
         Err(err) => Loaded::unreadable(name, &err),
     }
+    .read_first(path)
 }
 
 /// Reads EDS/DCF content; `file` names it in diagnostics and origins.
@@ -59,5 +60,6 @@ pub fn read_bytes(file: &str, bytes: &[u8], options: Options) -> Loaded {
     Loaded {
         device: Some(device),
         diagnostics,
+        files: Vec::new(),
     }
 }

@@ -1,17 +1,29 @@
 //! Lowers a parsed [`Table`] into an [`ir::Device`] in the documented order:
 //! base → delete → modify → add → semantics → PDO defaults → error tables,
 //! variants and the checks across the device.
+//!
+//! The base is the table's own `base:` EDS, or a device the caller gives
+//! ([`Base::Given`], an overlay passed to the builder); the stages after it
+//! are the same for both.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 use serde_saphyr::Spanned;
 
 use super::schema::{DeviceDef, Table};
-use super::{At, Ctx};
+use super::{At, Base, Ctx};
 use crate::input::Options;
 use crate::ir::{Device, Identity};
 
-pub(super) fn lower(ctx: &mut Ctx, table: &Table, base_dir: &Path, options: Options) -> Device {
+/// Lowers `table`; every file read on the way (a `base:` EDS) is appended
+/// to `files`.
+pub(super) fn lower(
+    ctx: &mut Ctx,
+    table: &Table,
+    base: Base,
+    options: Options,
+    files: &mut Vec<PathBuf>,
+) -> Device {
     if table.format.value != 1 {
         ctx.error(
             "table::format",
@@ -24,13 +36,32 @@ pub(super) fn lower(ctx: &mut Ctx, table: &Table, base_dir: &Path, options: Opti
             ),
         );
     }
-    let mut device = match &table.base {
-        Some(base) => match read_base(ctx, base, base_dir, options) {
-            Some(device) => device,
-            // Every later stage would only repeat that the base is missing.
-            None => return Device::default(),
-        },
-        None => whole_device_start(ctx, table),
+    let has_base = table.base.is_some() || matches!(base, Base::Given(_));
+    let mut device = match (base, &table.base) {
+        (Base::Key(base_dir), Some(key)) => {
+            match read_base(ctx, key, base_dir, options, files) {
+                Some(device) => device,
+                // Every later stage would only repeat that the base is missing.
+                None => return Device::default(),
+            }
+        }
+        (Base::Key(_), None) => whole_device_start(ctx, table),
+        (Base::Given(device), key) => {
+            if let Some(key) = key {
+                ctx.error(
+                    "table::overlay-base",
+                    At::of(key),
+                    "",
+                    "base",
+                    format!(
+                        "this overlay is applied on the device it is given for; \
+                         it must not name a base of its own (`{}` is not read)",
+                        key.value
+                    ),
+                );
+            }
+            *device
+        }
     };
     if let Some(def) = &table.device {
         apply_identity(ctx, &mut device.identity, def, true);
@@ -50,7 +81,7 @@ pub(super) fn lower(ctx: &mut Ctx, table: &Table, base_dir: &Path, options: Opti
         ("delete", table.delete.first().map(At::of)),
         ("modify", table.modify.first().map(At::of)),
     ];
-    if table.base.is_none() {
+    if !has_base {
         for (key, at) in overlay_only {
             if let Some(at) = at {
                 ctx.error(
@@ -94,9 +125,11 @@ fn read_base(
     base: &Spanned<String>,
     base_dir: &Path,
     options: Options,
+    files: &mut Vec<PathBuf>,
 ) -> Option<Device> {
     let path = base_dir.join(&base.value);
     let loaded = crate::eds::read_file(&path, options);
+    files.extend(loaded.files);
     let failed = loaded.diagnostics.has_errors();
     ctx.diags.extend(loaded.diagnostics);
     match loaded.device {

@@ -1,6 +1,7 @@
-//! The YAML object table reader: YAML text → [`schema::Table`] → [`ir::Device`].
+//! The YAML object table reader: YAML text → [`schema::Table`] → [`ir::Device`](crate::ir::Device).
 //!
-//! A table describes a whole device or overlays an EDS file (`base:`); the
+//! A table describes a whole device, overlays an EDS file (`base:`), or
+//! overlays a device the caller already read ([`apply_overlay`]); the
 //! format is documented in `docs/yaml-tables.md`. Shape errors (YAML syntax,
 //! unknown keys, wrong scalar types) stop at the first, as serde does; every
 //! semantic error is collected. Nothing here panics on any input.
@@ -18,6 +19,7 @@ use serde_saphyr::Spanned;
 
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
 use crate::input::{Loaded, Options};
+use crate::ir::Device;
 
 /// Reads a YAML object table from disk. A `base:` EDS is read relative to
 /// the table's directory.
@@ -30,11 +32,44 @@ pub fn read_file(path: &Path, options: Options) -> Loaded {
         }
         Err(err) => Loaded::unreadable(name, &err),
     }
+    .read_first(path)
 }
 
 /// Reads YAML table content; `file` names it in diagnostics and origins,
 /// `base_dir` is where a `base:` path is resolved.
 pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: Options) -> Loaded {
+    read_table(file, bytes, Base::Key(base_dir), options)
+}
+
+/// Reads the YAML overlay table at `path` and applies it on `base`, a device
+/// already read (from an EDS, a table, or earlier overlays), in the same
+/// stage order as an overlay with `base:` (delete → modify → add → semantics
+/// → PDO defaults → error tables, variants and checks).
+///
+/// The table must not name a `base:` of its own: that is an error
+/// (`table::overlay-base`) at the `base` key, and that file is not read.
+/// The result's device is absent only when the overlay could not be read or
+/// parsed at all; [`Loaded::files`] lists the overlay.
+pub fn apply_overlay(base: Device, path: &Path, options: Options) -> Loaded {
+    let name = path.display().to_string();
+    match std::fs::read(path) {
+        Ok(bytes) => read_table(&name, &bytes, Base::Given(Box::new(base)), options),
+        Err(err) => Loaded::unreadable(name, &err),
+    }
+    .read_first(path)
+}
+
+/// Where the device a table starts from comes from.
+pub(crate) enum Base<'a> {
+    /// The table's own `base:` key, resolved in this directory; without the
+    /// key, the table is a whole device.
+    Key(&'a Path),
+    /// Given by the caller: the table is an overlay on it.
+    Given(Box<Device>),
+}
+
+fn read_table(file: &str, bytes: &[u8], base: Base, options: Options) -> Loaded {
+    let mut files = Vec::new();
     let mut diagnostics = Diagnostics::new();
     let text = match std::str::from_utf8(bytes) {
         Ok(text) => text.strip_prefix('\u{feff}').unwrap_or(text),
@@ -61,6 +96,7 @@ pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: Options) -
             return Loaded {
                 device: None,
                 diagnostics,
+                files,
             };
         }
     };
@@ -74,7 +110,7 @@ pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: Options) -
                 text,
                 diags: &mut diagnostics,
             };
-            Some(lower::lower(&mut ctx, &table, base_dir, options))
+            Some(lower::lower(&mut ctx, &table, base, options, &mut files))
         }
         Err(err) => {
             let at = err.location().map(|l| At::from_location(&l));
@@ -102,6 +138,7 @@ pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: Options) -
     Loaded {
         device,
         diagnostics,
+        files,
     }
 }
 

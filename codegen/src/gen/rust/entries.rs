@@ -20,8 +20,6 @@ use crate::ir::{Access, DataType, Device, Entry, Literal, Object, ObjectKind, Va
 /// What other generators need to know of an entry's generated types.
 #[derive(Debug, Clone)]
 pub(crate) struct EntryInfo {
-    /// Path of the zero-sized type from the file's root.
-    pub(crate) zst: Vec<Ident>,
     /// Path of the value type from the root, `None` for a primitive.
     pub(crate) value: Option<Vec<Ident>>,
     /// The raw type, `None` when the entry has no fixed size.
@@ -83,7 +81,10 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
             let plan = values::plan(entry, error_plan(cx, entry), &mut types);
             root_plans.push((object, entry, zst, plan));
         } else {
-            module_ids.push((object, modules.request(&object.name, &key, Some(&object.origin))));
+            module_ids.push((
+                object,
+                modules.request(&object.name, &key, Some(&object.origin)),
+            ));
         }
     }
     let type_names = types.resolve(cx.diags);
@@ -93,8 +94,20 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
     for (object, entry, zst, plan) in &root_plans {
         let ident = type_names.get(*zst);
         let path = vec![super::naming::ident("od")];
-        items.extend(entry_items(cx, object, entry, &ident, plan, &type_names, &path, &object.name));
-        infos.insert((object.index, entry.subindex), info(cx, &path, &ident, plan, &type_names));
+        items.extend(entry_items(
+            cx,
+            object,
+            entry,
+            &ident,
+            plan,
+            &type_names,
+            &path,
+            &object.name,
+        ));
+        infos.insert(
+            (object.index, entry.subindex),
+            info(cx, &path, plan, &type_names),
+        );
     }
     for (object, id) in module_ids {
         let module = module_names.get(id);
@@ -104,7 +117,11 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
             .entries
             .values()
             .map(|entry| {
-                let zst = ns.request(&entry.name, &format!("sub {}", entry.subindex), Some(&entry.origin));
+                let zst = ns.request(
+                    &entry.name,
+                    &format!("sub {}", entry.subindex),
+                    Some(&entry.origin),
+                );
                 let plan = values::plan(entry, error_plan(cx, entry), &mut ns);
                 (entry, zst, plan)
             })
@@ -114,8 +131,20 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
         let mut inner = TokenStream::new();
         for (entry, zst, plan) in &plans {
             let ident = names.get(*zst);
-            inner.extend(entry_items(cx, object, entry, &ident, plan, &names, &path, &entry.name));
-            infos.insert((object.index, entry.subindex), info(cx, &path, &ident, plan, &names));
+            inner.extend(entry_items(
+                cx,
+                object,
+                entry,
+                &ident,
+                plan,
+                &names,
+                &path,
+                &entry.name,
+            ));
+            infos.insert(
+                (object.index, entry.subindex),
+                info(cx, &path, plan, &names),
+            );
         }
         let mut doc = Doc::new();
         doc.para(format!(
@@ -143,23 +172,26 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
     (items, infos)
 }
 
-fn info(cx: &Ctx, module: &[Ident], zst: &Ident, plan: &Plan, names: &Names) -> EntryInfo {
-    let mut zst_path = module.to_vec();
-    zst_path.push(zst.clone());
+fn info(cx: &Ctx, module: &[Ident], plan: &Plan, names: &Names) -> EntryInfo {
     let (value, raw) = match plan {
         Plan::Prim(p) => (None, Some(*p)),
         Plan::Bytes(_) => (None, None),
         Plan::Error(i) => {
             let plan = &cx.errors[*i];
-            (Some(vec![super::naming::ident("errors"), plan.ident.clone()]), Some(plan.raw))
+            (
+                Some(vec![super::naming::ident("errors"), plan.ident.clone()]),
+                Some(plan.raw),
+            )
         }
-        Plan::Enum { name, raw, .. } | Plan::Bits { name, raw, .. } | Plan::Scaled { name, raw } => {
+        Plan::Enum { name, raw, .. }
+        | Plan::Bits { name, raw, .. }
+        | Plan::Scaled { name, raw } => {
             let mut path = module.to_vec();
             path.push(names.get(*name));
             (Some(path), Some(*raw))
         }
     };
-    EntryInfo { zst: zst_path, value, raw }
+    EntryInfo { value, raw }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -176,7 +208,12 @@ fn entry_items(
     let rt = cx.rt;
     let depth = module.len();
     let errors = cx.errors;
-    let error_path = |i: usize| rooted(&[super::naming::ident("errors"), errors[i].ident.clone()], depth);
+    let error_path = |i: usize| {
+        rooted(
+            &[super::naming::ident("errors"), errors[i].ident.clone()],
+            depth,
+        )
+    };
     let value_ty = values::type_tokens(plan, names, rt, &error_path);
     let var = matches!(object.kind, ObjectKind::Var | ObjectKind::Domain);
     let index = super::prim::hex(u128::from(object.index));
@@ -213,7 +250,10 @@ fn entry_items(
             }
         });
     }
-    let mut vcx = values::Ctx { rt, diags: cx.diags };
+    let mut vcx = values::Ctx {
+        rt,
+        diags: cx.diags,
+    };
     out.extend(values::emit(&mut vcx, entry, plan, names));
     out
 }
@@ -223,9 +263,16 @@ fn entry_doc(object: &Object, entry: &Entry, var: bool) -> Doc {
     let title = if var || entry.name == object.name {
         format!("**{}**", docs::text(&entry.name))
     } else {
-        format!("**{}** of {}", docs::text(&entry.name), docs::text(&object.name))
+        format!(
+            "**{}** of {}",
+            docs::text(&entry.name),
+            docs::text(&object.name)
+        )
     };
-    doc.para(format!("{title} ({}).", docs::entry_facts(object.index, entry, var)));
+    doc.para(format!(
+        "{title} ({}).",
+        docs::entry_facts(object.index, entry, var)
+    ));
     if let Some(description) = &entry.semantics.description {
         doc.source_para(description);
     }
@@ -301,7 +348,11 @@ fn raw_literal(value: &Value, raw: Prim) -> Option<TokenStream> {
         }
         (Value::Real(f), Prim::F32 | Prim::F64) if f.is_finite() => {
             let lit = proc_macro2::Literal::f64_unsuffixed(f.abs());
-            Some(if *f < 0.0 { quote!(-#lit) } else { quote!(#lit) })
+            Some(if *f < 0.0 {
+                quote!(-#lit)
+            } else {
+                quote!(#lit)
+            })
         }
         (Value::Integer(v), Prim::F32 | Prim::F64) if v.unsigned_abs() < (1 << 53) => {
             let lit = proc_macro2::Literal::f64_unsuffixed(v.unsigned_abs() as f64);

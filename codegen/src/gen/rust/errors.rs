@@ -64,15 +64,30 @@ pub(crate) fn plan(device: &Device, diags: &mut Diagnostics) -> Vec<ErrorPlan> {
 }
 
 /// The `errors` module's items.
-pub(crate) fn emit(device: &Device, plans: &[ErrorPlan], rt: &TokenStream, diags: &mut Diagnostics) -> TokenStream {
+pub(crate) fn emit(
+    device: &Device,
+    plans: &[ErrorPlan],
+    rt: &TokenStream,
+    diags: &mut Diagnostics,
+) -> TokenStream {
     let mut out = TokenStream::new();
     for plan in plans {
-        out.extend(emit_table(&device.error_tables[plan.table], plan, rt, diags));
+        out.extend(emit_table(
+            &device.error_tables[plan.table],
+            plan,
+            rt,
+            diags,
+        ));
     }
     out
 }
 
-fn emit_table(table: &ErrorTable, plan: &ErrorPlan, rt: &TokenStream, diags: &mut Diagnostics) -> TokenStream {
+fn emit_table(
+    table: &ErrorTable,
+    plan: &ErrorPlan,
+    rt: &TokenStream,
+    diags: &mut Diagnostics,
+) -> TokenStream {
     let name = &plan.ident;
     let ty = plan.raw.tokens();
     let mut ns = Namespace::new(format!("enum `errors::{name}`"), Case::UpperCamel);

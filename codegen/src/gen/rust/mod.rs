@@ -71,7 +71,10 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
                 code: "gen::runtime-path",
                 file: device.source.clone(),
                 location: Location::default(),
-                message: format!("runtime path `{}` is not a Rust path: {err}", options.runtime_path),
+                message: format!(
+                    "runtime path `{}` is not a Rust path: {err}",
+                    options.runtime_path
+                ),
                 notes: Vec::new(),
             });
             return Err(diags);
@@ -162,8 +165,16 @@ fn identity_items(device: &Device) -> TokenStream {
         }
     };
     number_const("VENDOR_ID", " Vendor id (0x1018 sub 1).", id.vendor_number);
-    number_const("PRODUCT_CODE", " Product code (0x1018 sub 2).", id.product_number);
-    number_const("REVISION_NUMBER", " Revision number (0x1018 sub 3).", id.revision_number);
+    number_const(
+        "PRODUCT_CODE",
+        " Product code (0x1018 sub 2).",
+        id.product_number,
+    );
+    number_const(
+        "REVISION_NUMBER",
+        " Revision number (0x1018 sub 3).",
+        id.revision_number,
+    );
     let device_type = device
         .objects
         .get(&0x1000)
@@ -174,7 +185,11 @@ fn identity_items(device: &Device) -> TokenStream {
             Value::Integer(v) => u32::try_from(v).ok(),
             _ => None,
         });
-    number_const("DEVICE_TYPE", " Device type (0x1000), as delivered.", device_type);
+    number_const(
+        "DEVICE_TYPE",
+        " Device type (0x1000), as delivered.",
+        device_type,
+    );
     let node_id = device
         .network
         .node_id

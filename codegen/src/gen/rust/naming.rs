@@ -11,7 +11,7 @@
 
 use std::collections::BTreeMap;
 
-use heck::{ToShoutySnakeCase, ToSnakeCase, ToUpperCamelCase};
+use heck::{ToSnakeCase, ToUpperCamelCase};
 use proc_macro2::{Ident, Span};
 
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
@@ -24,19 +24,67 @@ pub(crate) enum Case {
     UpperCamel,
     /// Modules, fields, functions.
     Snake,
-    /// Constants.
-    ShoutySnake,
 }
 
 /// Rust's strict and reserved keywords (edition 2024) plus the names that
 /// cannot be raw identifiers.
 const KEYWORDS: &[&str] = &[
-    "as", "async", "await", "break", "const", "continue", "crate", "dyn", "else", "enum", "extern",
-    "false", "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut",
-    "pub", "ref", "return", "self", "Self", "static", "struct", "super", "trait", "true", "type",
-    "unsafe", "use", "where", "while", "abstract", "become", "box", "do", "final", "macro",
-    "override", "priv", "try", "typeof", "unsized", "virtual", "yield", "union", "macro_rules",
-    "raw", "safe",
+    "as",
+    "async",
+    "await",
+    "break",
+    "const",
+    "continue",
+    "crate",
+    "dyn",
+    "else",
+    "enum",
+    "extern",
+    "false",
+    "fn",
+    "for",
+    "gen",
+    "if",
+    "impl",
+    "in",
+    "let",
+    "loop",
+    "match",
+    "mod",
+    "move",
+    "mut",
+    "pub",
+    "ref",
+    "return",
+    "self",
+    "Self",
+    "static",
+    "struct",
+    "super",
+    "trait",
+    "true",
+    "type",
+    "unsafe",
+    "use",
+    "where",
+    "while",
+    "abstract",
+    "become",
+    "box",
+    "do",
+    "final",
+    "macro",
+    "override",
+    "priv",
+    "try",
+    "typeof",
+    "unsized",
+    "virtual",
+    "yield",
+    "union",
+    "macro_rules",
+    "raw",
+    "safe",
 ];
 
 /// `text` as an identifier of `case`, or `""` when nothing usable remains.
@@ -58,7 +106,6 @@ pub(crate) fn sanitize(text: &str, case: Case) -> String {
     let mut name = match case {
         Case::UpperCamel => ascii.to_upper_camel_case(),
         Case::Snake => ascii.to_snake_case(),
-        Case::ShoutySnake => ascii.to_shouty_snake_case(),
     };
     if name.is_empty() {
         return name;
@@ -69,7 +116,6 @@ pub(crate) fn sanitize(text: &str, case: Case) -> String {
             match case {
                 Case::UpperCamel => "N",
                 Case::Snake => "n_",
-                Case::ShoutySnake => "N_",
             },
         );
     }
@@ -152,12 +198,7 @@ impl Namespace {
     /// Requests a name for `source`; `key` tells it apart from others when
     /// needed (`x2001`, `sub 3`, `code 0x10`) and names it when the source
     /// name has nothing usable.
-    pub(crate) fn request(
-        &mut self,
-        source: &str,
-        key: &str,
-        origin: Option<&Origin>,
-    ) -> NameId {
+    pub(crate) fn request(&mut self, source: &str, key: &str, origin: Option<&Origin>) -> NameId {
         self.requests.push(Request {
             base: sanitize(source, self.case),
             key: key.to_string(),
@@ -184,7 +225,7 @@ impl Namespace {
                 continue;
             }
             let group = &groups[r.base.as_str()];
-            let clash_reserved = self.reserved.iter().any(|n| *n == r.base);
+            let clash_reserved = self.reserved.contains(&r.base);
             names.push(if group.len() > 1 || clash_reserved {
                 qualified(r)
             } else {
@@ -228,7 +269,7 @@ impl Namespace {
 fn sep(case: Case) -> &'static str {
     match case {
         Case::UpperCamel => "",
-        Case::Snake | Case::ShoutySnake => "_",
+        Case::Snake => "_",
     }
 }
 
@@ -244,7 +285,11 @@ fn report(
     let mut notes = Vec::new();
     for (&i, name) in members.iter().zip(renamed) {
         let r = &requests[i];
-        notes.push(format!("`{}` at {} is named `{name}`", r.source, at(r.origin.as_ref())));
+        notes.push(format!(
+            "`{}` at {} is named `{name}`",
+            r.source,
+            at(r.origin.as_ref())
+        ));
     }
     let others: Vec<String> = members[1..]
         .iter()
@@ -293,7 +338,10 @@ mod tests {
 
     #[test]
     fn sanitising() {
-        assert_eq!(sanitize("Motor-Temperatur (°C)", Case::UpperCamel), "MotorTemperaturC");
+        assert_eq!(
+            sanitize("Motor-Temperatur (°C)", Case::UpperCamel),
+            "MotorTemperaturC"
+        );
         assert_eq!(sanitize("Größe über", Case::Snake), "groesse_ueber");
         assert_eq!(sanitize("1st value", Case::Snake), "n_1st_value");
         assert_eq!(sanitize("1st value", Case::UpperCamel), "N1stValue");
@@ -301,7 +349,6 @@ mod tests {
         assert_eq!(sanitize("self", Case::Snake), "self_");
         assert_eq!(sanitize("Self", Case::UpperCamel), "Self_");
         assert_eq!(sanitize("\"]; } 🚀", Case::Snake), "");
-        assert_eq!(sanitize("max speed", Case::ShoutySnake), "MAX_SPEED");
     }
 
     #[test]
@@ -326,7 +373,10 @@ mod tests {
         assert_eq!(names.text(e), "X2005");
         assert_eq!(diags.len(), 2);
         let text = diags.to_string();
-        assert!(text.contains("a.eds:10") && text.contains("a.eds:20"), "{text}");
+        assert!(
+            text.contains("a.eds:10") && text.contains("a.eds:20"),
+            "{text}"
+        );
     }
 
     #[test]

@@ -6,7 +6,7 @@
 use std::collections::BTreeMap;
 
 use proc_macro2::{Literal, TokenStream};
-use quote::{format_ident, quote};
+use quote::quote;
 
 use super::docs::{self, Doc};
 use super::entries::EntryInfo;
@@ -46,7 +46,11 @@ pub(crate) fn emit(
 ) -> TokenStream {
     let mut structs = Namespace::new("module `pdo`", Case::UpperCamel);
     let mut planned = Vec::new();
-    for mapping in device.objects.values().filter(|o| is_mapping_object(o.index)) {
+    for mapping in device
+        .objects
+        .values()
+        .filter(|o| is_mapping_object(o.index))
+    {
         let Some((layout, fields_ns)) = layout(device, mapping, infos, diags) else {
             continue;
         };
@@ -62,7 +66,11 @@ pub(crate) fn emit(
             Some(label) => format!("{prefix}{} {}", layout.number, label.name),
             None => format!("{prefix}{}", layout.number),
         };
-        let id = structs.request(&source, &format!("x{:04X}", mapping.index), Some(&mapping.origin));
+        let id = structs.request(
+            &source,
+            &format!("x{:04X}", mapping.index),
+            Some(&mapping.origin),
+        );
         planned.push((layout, fields_ns, label, id));
     }
     let names = structs.resolve(diags);
@@ -70,7 +78,14 @@ pub(crate) fn emit(
     for (layout, fields_ns, label, id) in planned {
         let field_names = fields_ns.resolve(diags);
         let ident = names.get(id);
-        out.extend(emit_struct(device, &layout, &ident, label, &field_names, rt));
+        out.extend(emit_struct(
+            device,
+            &layout,
+            &ident,
+            label,
+            &field_names,
+            rt,
+        ));
     }
     out
 }
@@ -100,13 +115,24 @@ fn layout<'a>(
     } else {
         (PdoDirection::Rpdo, mapping.index - 0x1600 + 1)
     };
-    let count = mapping.entries.get(&0).and_then(raw_mapping).unwrap_or(u32::MAX);
+    let count = mapping
+        .entries
+        .get(&0)
+        .and_then(raw_mapping)
+        .unwrap_or(u32::MAX);
     let name = format!("{direction:?}{number}").to_uppercase();
-    let mut fields_ns = Namespace::new(format!("struct of {name} (0x{:04X})", mapping.index), Case::Snake);
+    let mut fields_ns = Namespace::new(
+        format!("struct of {name} (0x{:04X})", mapping.index),
+        Case::Snake,
+    );
     let mut fields = Vec::new();
     let mut gaps = Vec::new();
     let mut offset = 0u32;
-    for entry in mapping.entries.values().filter(|e| e.subindex >= 1 && u32::from(e.subindex) <= count) {
+    for entry in mapping
+        .entries
+        .values()
+        .filter(|e| e.subindex >= 1 && u32::from(e.subindex) <= count)
+    {
         let Some(raw) = raw_mapping(entry).filter(|&r| r != 0) else {
             continue;
         };
@@ -118,11 +144,22 @@ fn layout<'a>(
             .filter(|p| !matches!(p, MappingProblem::NotMappable { .. }))
             .collect();
         if let Some(problem) = fatal.first() {
-            warn(diags, mapping, format!("{name} is not generated: sub {} {problem}", entry.subindex));
+            warn(
+                diags,
+                mapping,
+                format!("{name} is not generated: sub {} {problem}", entry.subindex),
+            );
             return None;
         }
         if width == 0 {
-            warn(diags, mapping, format!("{name} is not generated: sub {} maps 0 bits", entry.subindex));
+            warn(
+                diags,
+                mapping,
+                format!(
+                    "{name} is not generated: sub {} maps 0 bits",
+                    entry.subindex
+                ),
+            );
             return None;
         }
         if target.is_dummy() {
@@ -131,21 +168,42 @@ fn layout<'a>(
             continue;
         }
         let Some(info) = infos.get(&(target.index, target.subindex)) else {
-            warn(diags, mapping, format!("{name} is not generated: 0x{:04X} sub {} has no generated type", target.index, target.subindex));
+            warn(
+                diags,
+                mapping,
+                format!(
+                    "{name} is not generated: 0x{:04X} sub {} has no generated type",
+                    target.index, target.subindex
+                ),
+            );
             return None;
         };
         let Some(raw_prim) = info.raw else {
-            warn(diags, mapping, format!("{name} is not generated: 0x{:04X} sub {} has no fixed size", target.index, target.subindex));
+            warn(
+                diags,
+                mapping,
+                format!(
+                    "{name} is not generated: 0x{:04X} sub {} has no fixed size",
+                    target.index, target.subindex
+                ),
+            );
             return None;
         };
         let object = &device.objects[&target.index];
         let mapped = &object.entries[&target.subindex];
-        let source = if matches!(object.kind, crate::ir::ObjectKind::Var | crate::ir::ObjectKind::Domain) {
+        let source = if matches!(
+            object.kind,
+            crate::ir::ObjectKind::Var | crate::ir::ObjectKind::Domain
+        ) {
             &object.name
         } else {
             &mapped.name
         };
-        let name_id = fields_ns.request(source, &format!("x{:04X} sub {}", target.index, target.subindex), Some(&mapped.origin));
+        let name_id = fields_ns.request(
+            source,
+            &format!("x{:04X} sub {}", target.index, target.subindex),
+            Some(&mapped.origin),
+        );
         fields.push(Field {
             target,
             offset,
@@ -159,7 +217,13 @@ fn layout<'a>(
         offset += width;
     }
     if offset > 64 {
-        warn(diags, mapping, format!("{name} is not generated: its mapping totals {offset} bits; a PDO carries at most 64"));
+        warn(
+            diags,
+            mapping,
+            format!(
+                "{name} is not generated: its mapping totals {offset} bits; a PDO carries at most 64"
+            ),
+        );
         return None;
     }
     if fields.is_empty() {
@@ -180,9 +244,17 @@ fn layout<'a>(
 
 fn span_text(offset: u32, width: u32) -> (String, String) {
     let last = offset + width - 1;
-    let bits = if width == 1 { offset.to_string() } else { format!("{offset}–{last}") };
-    let bytes = if offset % 8 == 0 && width % 8 == 0 {
-        if width == 8 { (offset / 8).to_string() } else { format!("{}–{}", offset / 8, last / 8) }
+    let bits = if width == 1 {
+        offset.to_string()
+    } else {
+        format!("{offset}–{last}")
+    };
+    let bytes = if offset.is_multiple_of(8) && width.is_multiple_of(8) {
+        if width == 8 {
+            (offset / 8).to_string()
+        } else {
+            format!("{}–{}", offset / 8, last / 8)
+        }
     } else {
         format!("{}.{}–{}.{}", offset / 8, offset % 8, last / 8, last % 8)
     };
@@ -217,7 +289,10 @@ fn emit_struct(
         doc.source_para(description);
     }
     let comm = device.objects.get(&comm_index);
-    let comm_default = |sub: u8| comm.and_then(|o| o.entries.get(&sub)).and_then(|e| e.default.as_ref());
+    let comm_default = |sub: u8| {
+        comm.and_then(|o| o.entries.get(&sub))
+            .and_then(|e| e.default.as_ref())
+    };
     let mut facts = Vec::new();
     if let Some(t) = comm_default(2) {
         facts.push(format!("transmission type {}", docs::text(&t.text)));
@@ -233,14 +308,27 @@ fn emit_struct(
     let mut rows: Vec<(u32, String)> = Vec::new();
     for f in &layout.fields {
         let (bits, bytes) = span_text(f.offset, f.width);
-        rows.push((f.offset, format!(
-            "| {bits} | {bytes} | `{}` | 0x{:04X} sub {} {} | {} |",
-            names.text(f.name), f.target.index, f.target.subindex, docs::text(f.entry_name), f.data_type.name()
-        )));
+        rows.push((
+            f.offset,
+            format!(
+                "| {bits} | {bytes} | `{}` | 0x{:04X} sub {} {} | {} |",
+                names.text(f.name),
+                f.target.index,
+                f.target.subindex,
+                docs::text(f.entry_name),
+                f.data_type.name()
+            ),
+        ));
     }
     for &(offset, width, data_type) in &layout.gaps {
         let (bits, bytes) = span_text(offset, width);
-        rows.push((offset, format!("| {bits} | {bytes} | (gap) | dummy | {} |", data_type.name())));
+        rows.push((
+            offset,
+            format!(
+                "| {bits} | {bytes} | (gap) | dummy | {} |",
+                data_type.name()
+            ),
+        ));
     }
     rows.sort();
     for (_, row) in rows {
@@ -261,9 +349,18 @@ fn emit_struct(
         let ty = f.info.value_tokens(1);
         float |= f.raw.is_float();
         let (bits, bytes) = span_text(f.offset, f.width);
-        let field_doc = format!(" **{}** (0x{:04X} sub {}): bits {bits}, bytes {bytes}.", docs::text(f.entry_name), f.target.index, f.target.subindex);
+        let field_doc = format!(
+            " **{}** (0x{:04X} sub {}): bits {bits}, bytes {bytes}.",
+            docs::text(f.entry_name),
+            f.target.index,
+            f.target.subindex
+        );
         defs.push(quote!(#[doc = #field_doc] pub #name: #ty));
-        let mask = if f.width == 64 { u64::MAX } else { (1u64 << f.width) - 1 };
+        let mask = if f.width == 64 {
+            u64::MAX
+        } else {
+            (1u64 << f.width) - 1
+        };
         let mask_lit = prim::hex(u128::from(mask));
         let shift = Literal::u32_unsuffixed(f.offset);
         let needs_mask = f.offset + f.width < 64;
@@ -319,10 +416,9 @@ fn emit_struct(
     let number = Literal::u16_unsuffixed(layout.number);
     let comm_lit = prim::hex(u128::from(comm_index));
     let map_lit = prim::hex(u128::from(layout.mapping.index));
-    let decode_doc = format!(" Decodes the data of a frame; it must be exactly {len} bytes. Never panics.");
+    let decode_doc =
+        format!(" Decodes the data of a frame; it must be exactly {len} bytes. Never panics.");
     let encode_doc = format!(" The {len} data bytes of the frame.");
-    let _ = format_ident!("unused");
-    let _ = Value::Integer(0);
     quote! {
         #doc
         #derives
@@ -379,12 +475,18 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
     let Ok(value) = u32::try_from(value) else {
         return TokenStream::new();
     };
-    let id_mask = if value & (1 << 29) != 0 { 0x1FFF_FFFFu32 } else { 0x7FF };
+    let id_mask = if value & (1 << 29) != 0 {
+        0x1FFF_FFFFu32
+    } else {
+        0x7FF
+    };
     let id_mask = prim::hex(u128::from(id_mask));
     let value_lit = prim::hex(u128::from(value));
     let text = docs::text(&literal.text);
     if literal.plus_node_id {
-        let doc = format!(" The default COB-ID entry value for a node: {text} (bit 31 set means the PDO is disabled).");
+        let doc = format!(
+            " The default COB-ID entry value for a node: {text} (bit 31 set means the PDO is disabled)."
+        );
         quote! {
             #[doc = #doc]
             pub const fn cob_id(node_id: #rt::od::NodeId) -> u32 {
@@ -396,7 +498,9 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
             }
         }
     } else {
-        let doc = format!(" The default COB-ID entry value, {text} (bit 31 set means the PDO is disabled).");
+        let doc = format!(
+            " The default COB-ID entry value, {text} (bit 31 set means the PDO is disabled)."
+        );
         quote! {
             #[doc = #doc]
             pub const COB_ID: u32 = #value_lit;

@@ -192,6 +192,6 @@ mod tests {
         assert_eq!(hex(0xFB00).to_string(), "0xFB00");
         assert_eq!(hex(0x1_0000).to_string(), "0x010000");
         assert_eq!(hex(0x6000_0000).to_string(), "0x6000_0000");
-        assert_eq!(hex(0x1_2345_6789).to_string(), "0x0001_2345_6789");
+        assert_eq!(hex(0x1_2345_6789).to_string(), "0x01_2345_6789");
     }
 }

@@ -49,7 +49,11 @@ pub(crate) fn plan(entry: &Entry, error_plan: Option<usize>, ns: &mut Namespace)
     let s = &entry.semantics;
     let key = format!("sub {}", entry.subindex);
     let req = |ns: &mut Namespace, suffix: &str| {
-        ns.request(&format!("{} {suffix}", entry.name), &key, Some(&entry.origin))
+        ns.request(
+            &format!("{} {suffix}", entry.name),
+            &key,
+            Some(&entry.origin),
+        )
     };
     if raw.is_integer() {
         if let Some(index) = error_plan {
@@ -102,7 +106,12 @@ fn bytes_marker(entry: &Entry) -> &'static str {
 }
 
 /// The Rust type of the plan's values, as a path relative to the entry's module.
-pub(crate) fn type_tokens(plan: &Plan, names: &Names, rt: &TokenStream, error_path: &dyn Fn(usize) -> TokenStream) -> TokenStream {
+pub(crate) fn type_tokens(
+    plan: &Plan,
+    names: &Names,
+    rt: &TokenStream,
+    error_path: &dyn Fn(usize) -> TokenStream,
+) -> TokenStream {
     match plan {
         Plan::Prim(p) => p.tokens(),
         Plan::Bytes(marker) => {
@@ -151,9 +160,16 @@ pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> T
                 }
                 None => raw.tokens(),
             };
-            let number_conv = number.map(|_| ());
             let doc = value_doc(entry, "The value");
-            out.extend(value_enum(cx, &name, *raw, table, &doc, Some((&number_ty, number_conv.is_some())), &entry.name));
+            out.extend(value_enum(
+                cx,
+                &name,
+                *raw,
+                table,
+                &doc,
+                Some((&number_ty, number.is_some())),
+                &entry.name,
+            ));
             out.extend(scalar_impl(cx.rt, &name, *raw));
             out
         }
@@ -172,20 +188,39 @@ pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> T
                         let enum_ident = names.get(*enum_name);
                         let field_raw = Prim::int(false, field.width);
                         let mut doc = Doc::new();
-                        doc.para(format!("Values of the bit field **{}** of {}.", docs::text(&field.name), docs::text(&entry.name)));
+                        doc.para(format!(
+                            "Values of the bit field **{}** of {}.",
+                            docs::text(&field.name),
+                            docs::text(&entry.name)
+                        ));
                         if let Some(text) = &field.text {
                             doc.source_para(text);
                         }
                         doc.origin(&field.origin);
                         let number_ty = field_raw.tokens();
-                        out.extend(value_enum(cx, &enum_ident, field_raw, table, &doc, Some((&number_ty, false)), &field.name));
+                        out.extend(value_enum(
+                            cx,
+                            &enum_ident,
+                            field_raw,
+                            table,
+                            &doc,
+                            Some((&number_ty, false)),
+                            &field.name,
+                        ));
                         field_enums.push(Some(enum_ident));
                     }
                     _ => field_enums.push(None),
                 }
             }
             let state = state.map(|id| names.get(id));
-            out.extend(bit_struct(cx, entry, &name, *raw, &field_enums, state.as_ref()));
+            out.extend(bit_struct(
+                cx,
+                entry,
+                &name,
+                *raw,
+                &field_enums,
+                state.as_ref(),
+            ));
             out.extend(scalar_impl(cx.rt, &name, *raw));
             out
         }
@@ -219,7 +254,7 @@ fn unit_doc(doc: &mut Doc, s: &Semantics) {
 /// rounded decimal (26 → 2.6, not 2.6000000000000005).
 enum Factor {
     Divide(f64),
-    Multiply(f64),
+    Multiply,
 }
 
 fn factor(scale: f64) -> Factor {
@@ -228,7 +263,7 @@ fn factor(scale: f64) -> Factor {
     if scale.abs() < 1.0 && rounded != 0.0 && (reciprocal - rounded).abs() < 1e-9 * rounded.abs() {
         Factor::Divide(rounded)
     } else {
-        Factor::Multiply(scale)
+        Factor::Multiply
     }
 }
 
@@ -244,23 +279,49 @@ fn f64_lit(value: f64) -> TokenStream {
 
 /// A newtype over the raw value with unit conversions. `numeric` limits
 /// `from_value` to the range that means a number (the other raws are special).
-fn scaled(name: &Ident, raw: Prim, s: &Semantics, numeric: Option<(i128, i128)>, doc: &Doc) -> TokenStream {
+fn scaled(
+    name: &Ident,
+    raw: Prim,
+    s: &Semantics,
+    numeric: Option<(i128, i128)>,
+    doc: &Doc,
+) -> TokenStream {
     let ty = raw.tokens();
     let doc = doc.tokens();
-    let scale = s.scale.filter(|v| v.is_finite() && *v != 0.0).unwrap_or(1.0);
+    let scale = s
+        .scale
+        .filter(|v| v.is_finite() && *v != 0.0)
+        .unwrap_or(1.0);
     let offset = s.offset.filter(|v| v.is_finite()).unwrap_or(0.0);
     let unit = s.unit.clone().unwrap_or_default();
-    let unit_doc = if unit.is_empty() { String::new() } else { format!(" in {}", docs::text(&unit)) };
+    let unit_doc = if unit.is_empty() {
+        String::new()
+    } else {
+        format!(" in {}", docs::text(&unit))
+    };
     let scale_lit = f64_lit(scale);
     let offset_lit = f64_lit(offset);
     let (to_value, to_steps) = match factor(scale) {
         Factor::Divide(k) => {
             let k = f64_lit(k);
-            (quote!(self.0 as f64 / #k), quote!((value - Self::OFFSET) * #k))
+            (
+                quote!(self.0 as f64 / #k),
+                quote!((value - Self::OFFSET) * #k),
+            )
         }
-        Factor::Multiply(_) => (quote!(self.0 as f64 * Self::SCALE), quote!((value - Self::OFFSET) / Self::SCALE)),
+        Factor::Multiply => (
+            quote!(self.0 as f64 * Self::SCALE),
+            quote!((value - Self::OFFSET) / Self::SCALE),
+        ),
     };
-    let value_fn_doc = format!(" The physical value{unit_doc}: raw × {scale}{}.", if offset != 0.0 { format!(" + {offset}") } else { String::new() });
+    let value_fn_doc = format!(
+        " The physical value{unit_doc}: raw × {scale}{}.",
+        if offset != 0.0 {
+            format!(" + {offset}")
+        } else {
+            String::new()
+        }
+    );
     let derives = if raw.is_float() {
         quote!(#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)])
     } else {
@@ -276,7 +337,9 @@ fn scaled(name: &Ident, raw: Prim, s: &Semantics, numeric: Option<(i128, i128)>,
     } else {
         let (low, high) = numeric.unwrap_or(raw.range());
         let (low_lit, high_lit) = (raw.lit(low), raw.lit(high));
-        let doc = format!(" The raw value nearest to `value`{unit_doc}, or `None` when that is outside {low}..={high} (or `value` is NaN).");
+        let doc = format!(
+            " The raw value nearest to `value`{unit_doc}, or `None` when that is outside {low}..={high} (or `value` is NaN)."
+        );
         quote! {
             #[doc = #doc]
             pub const fn from_value(value: f64) -> Option<Self> {
@@ -391,7 +454,11 @@ fn value_enum(
                 v.carries = true;
             }
             None => variants.push(Variant {
-                name: ns.request(&named.name, &format!("raw {}", named.low), Some(&named.origin)),
+                name: ns.request(
+                    &named.name,
+                    &format!("raw {}", named.low),
+                    Some(&named.origin),
+                ),
                 source: named.name.clone(),
                 text: named.text.as_deref(),
                 members: vec![(named.low, named.high)],
@@ -428,33 +495,67 @@ fn value_enum(
             Number(#number_ty)
         });
         let (l, h) = (raw.lit(low), raw.lit(high));
-        let wrap = if number_scaled { quote!(Self::Number(#number_ty::from_raw(raw))) } else { quote!(Self::Number(raw)) };
+        let wrap = if number_scaled {
+            quote!(Self::Number(#number_ty::from_raw(raw)))
+        } else {
+            quote!(Self::Number(raw))
+        };
         from_arms.push(quote!(#l..=#h => #wrap));
-        to_arms.push(if number_scaled { quote!(Self::Number(n) => n.to_raw()) } else { quote!(Self::Number(n) => n) });
+        to_arms.push(if number_scaled {
+            quote!(Self::Number(n) => n.to_raw())
+        } else {
+            quote!(Self::Number(n) => n)
+        });
         name_arms.push(quote!(Self::Number(_) => "number"));
         covered.push((low, high));
     }
     for (i, v) in variants.iter().enumerate() {
         let ident = names.get(v.name);
         let mut doc = Doc::new();
-        let raws: Vec<String> = v.members.iter().map(|&(l, h)| if l == h { format!("{l:#X}") } else { format!("{l:#X}..={h:#X}") }).collect();
+        let raws: Vec<String> = v
+            .members
+            .iter()
+            .map(|&(l, h)| {
+                if l == h {
+                    format!("{l:#X}")
+                } else {
+                    format!("{l:#X}..={h:#X}")
+                }
+            })
+            .collect();
         let mut head = format!("**{}**", docs::text(&v.source));
         if !raws.is_empty() {
             head.push_str(&format!(" (raw {})", raws.join(", ")));
         }
         if i == fallback {
-            head.push_str(if raws.is_empty() { ": every raw value not covered by another variant" } else { "; also every raw value not covered by another variant" });
+            head.push_str(if raws.is_empty() {
+                ": every raw value not covered by another variant"
+            } else {
+                "; also every raw value not covered by another variant"
+            });
         }
         doc.para(head);
         if let Some(text) = v.text {
             doc.source_para(text);
         }
         let doc = doc.tokens_with_alias(&v.source, names.text(v.name));
-        defs.push(if v.carries { quote!(#doc #ident(#ty)) } else { quote!(#doc #ident) });
+        defs.push(if v.carries {
+            quote!(#doc #ident(#ty))
+        } else {
+            quote!(#doc #ident)
+        });
         for &(low, high) in &v.members {
             let (l, h) = (raw.lit(low), raw.lit(high));
-            let pattern = if low == high { quote!(#l) } else { quote!(#l..=#h) };
-            from_arms.push(if v.carries { quote!(#pattern => Self::#ident(raw)) } else { quote!(#pattern => Self::#ident) });
+            let pattern = if low == high {
+                quote!(#l)
+            } else {
+                quote!(#l..=#h)
+            };
+            from_arms.push(if v.carries {
+                quote!(#pattern => Self::#ident(raw))
+            } else {
+                quote!(#pattern => Self::#ident)
+            });
             covered.push((low, high));
         }
         if v.carries {
@@ -464,16 +565,22 @@ fn value_enum(
             to_arms.push(quote!(Self::#ident => #l));
         }
         let source = &v.source;
-        let text = v.text.unwrap_or(&v.source);
-        name_arms.push(if v.carries { quote!(Self::#ident(_) => #source) } else { quote!(Self::#ident => #source) });
-        let _ = text;
+        name_arms.push(if v.carries {
+            quote!(Self::#ident(_) => #source)
+        } else {
+            quote!(Self::#ident => #source)
+        });
     }
     let text_arms: Vec<TokenStream> = variants
         .iter()
         .map(|v| {
             let ident = names.get(v.name);
             let text = v.text.unwrap_or(&v.source);
-            if v.carries { quote!(Self::#ident(_) => #text) } else { quote!(Self::#ident => #text) }
+            if v.carries {
+                quote!(Self::#ident(_) => #text)
+            } else {
+                quote!(Self::#ident => #text)
+            }
         })
         .chain(table.numeric.map(|_| quote!(Self::Number(_) => "number")))
         .collect();
@@ -482,7 +589,11 @@ fn value_enum(
         from_arms.push(quote!(_ => Self::#fallback_ident(raw)));
     }
     let has_float = number_scaled && raw.is_float();
-    let derives = if has_float { quote!(#[derive(Debug, Clone, Copy, PartialEq)]) } else { quote!(#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]) };
+    let derives = if has_float {
+        quote!(#[derive(Debug, Clone, Copy, PartialEq)])
+    } else {
+        quote!(#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)])
+    };
     let doc = doc.tokens();
     quote! {
         #doc
@@ -537,7 +648,14 @@ fn covers(intervals: &mut [(i128, i128)], range: (i128, i128)) -> bool {
     false
 }
 
-fn bit_struct(cx: &mut Ctx, entry: &Entry, name: &Ident, raw: Prim, field_enums: &[Option<Ident>], state: Option<&Ident>) -> TokenStream {
+fn bit_struct(
+    cx: &mut Ctx,
+    entry: &Entry,
+    name: &Ident,
+    raw: Prim,
+    field_enums: &[Option<Ident>],
+    state: Option<&Ident>,
+) -> TokenStream {
     let s = &entry.semantics;
     let ty = raw.tokens();
     let uty = raw.unsigned().tokens();
@@ -545,25 +663,57 @@ fn bit_struct(cx: &mut Ctx, entry: &Entry, name: &Ident, raw: Prim, field_enums:
     for fixed in ["from_raw", "to_raw", "state"] {
         methods.reserve(fixed);
     }
-    let ids: Vec<NameId> = s.bits.iter().map(|f| methods.request(&f.name, &format!("bit {}", f.lsb), Some(&f.origin))).collect();
-    let pattern_ids: Vec<NameId> = s.patterns.iter().map(|p| methods.request(&format!("is {}", p.name), "pattern", Some(&p.origin))).collect();
+    let ids: Vec<NameId> = s
+        .bits
+        .iter()
+        .map(|f| methods.request(&f.name, &format!("bit {}", f.lsb), Some(&f.origin)))
+        .collect();
+    let pattern_ids: Vec<NameId> = s
+        .patterns
+        .iter()
+        .map(|p| methods.request(&format!("is {}", p.name), "pattern", Some(&p.origin)))
+        .collect();
     let method_names = methods.resolve(cx.diags);
     let mut items = Vec::new();
     let mut layout = Doc::new();
-    layout.para("| Bits | Field | Meaning |");
+    layout.line(String::new());
+    layout.line("| Bits | Field | Meaning |");
     layout.line("|---|---|---|");
     for ((field, id), enum_ident) in s.bits.iter().zip(&ids).zip(field_enums) {
         let getter = method_names.get(*id);
         let setter = format_ident!("with_{}", method_names.text(*id).trim_end_matches('_'));
-        let bits_text = if field.width == 1 { format!("{}", field.lsb) } else { format!("{}–{}", field.lsb, field.lsb + field.width - 1) };
-        layout.line(format!("| {bits_text} | `{}` | {} |", method_names.text(*id), docs::text(field.text.as_deref().unwrap_or(&field.name))));
-        items.push(bit_field_methods(field, &getter, &setter, raw, enum_ident.as_ref()));
+        let bits_text = if field.width == 1 {
+            format!("{}", field.lsb)
+        } else {
+            format!("{}–{}", field.lsb, field.lsb + field.width - 1)
+        };
+        layout.line(format!(
+            "| {bits_text} | `{}` | {} |",
+            method_names.text(*id),
+            docs::text(field.text.as_deref().unwrap_or(&field.name))
+        ));
+        items.push(bit_field_methods(
+            field,
+            &getter,
+            &setter,
+            raw,
+            enum_ident.as_ref(),
+        ));
     }
+    let mut extra = TokenStream::new();
     if let Some(state) = state {
         let mut variants = Namespace::new(format!("enum `{state}`"), Case::UpperCamel);
-        let var_ids: Vec<NameId> = s.patterns.iter().map(|p| variants.request(&p.name, &format!("mask {:#X}", p.mask), Some(&p.origin))).collect();
+        let var_ids: Vec<NameId> = s
+            .patterns
+            .iter()
+            .map(|p| variants.request(&p.name, &format!("mask {:#X}", p.mask), Some(&p.origin)))
+            .collect();
         let var_names = variants.resolve(cx.diags);
-        let base = if raw.is_signed() { quote!((self.0 as #uty)) } else { quote!(self.0) };
+        let base = if raw.is_signed() {
+            quote!((self.0 as #uty))
+        } else {
+            quote!(self.0)
+        };
         let mut defs = Vec::new();
         let mut checks = Vec::new();
         for ((p, vid), mid) in s.patterns.iter().zip(&var_ids).zip(&pattern_ids) {
@@ -572,13 +722,23 @@ fn bit_struct(cx: &mut Ctx, entry: &Entry, name: &Ident, raw: Prim, field_enums:
             let mask = prim::hex(u128::from(p.mask));
             let value = prim::hex(u128::from(p.value));
             let mut doc = Doc::new();
-            doc.para(format!("**{}**: raw & {:#X} == {:#X}.", docs::text(&p.name), p.mask, p.value));
+            doc.para(format!(
+                "**{}**: raw & {:#X} == {:#X}.",
+                docs::text(&p.name),
+                p.mask,
+                p.value
+            ));
             if let Some(text) = &p.text {
                 doc.source_para(text);
             }
             let doc_tokens = doc.tokens_with_alias(&p.name, var_names.text(*vid));
             defs.push(quote!(#doc_tokens #v));
-            let method_doc = format!(" Whether the value matches the pattern **{}** (raw & {:#X} == {:#X}).", docs::text(&p.name), p.mask, p.value);
+            let method_doc = format!(
+                " Whether the value matches the pattern **{}** (raw & {:#X} == {:#X}).",
+                docs::text(&p.name),
+                p.mask,
+                p.value
+            );
             items.push(quote! {
                 #[doc = #method_doc]
                 pub const fn #m(self) -> bool {
@@ -587,12 +747,15 @@ fn bit_struct(cx: &mut Ctx, entry: &Entry, name: &Ident, raw: Prim, field_enums:
             });
             checks.push(quote!(if self.#m() { return Some(#state::#v); }));
         }
-        let doc = format!(" The named states of {} (masked patterns of the raw value).", docs::text(&entry.name));
-        let out = quote! {
+        let doc = format!(
+            " The named states of {} (masked patterns of the raw value).",
+            docs::text(&entry.name)
+        );
+        extra.extend(quote! {
             #[doc = #doc]
             #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
             pub enum #state { #(#defs,)* }
-        };
+        });
         items.push(quote! {
             #[doc = " The first named state whose pattern matches, if any."]
             pub const fn state(self) -> Option<#state> {
@@ -600,22 +763,26 @@ fn bit_struct(cx: &mut Ctx, entry: &Entry, name: &Ident, raw: Prim, field_enums:
                 None
             }
         });
-        let mut doc = value_doc(entry, "The bit fields");
-        let mut lines = layout.tokens();
-        if s.bits.is_empty() {
-            lines = TokenStream::new();
-        }
-        let _ = &mut doc;
-        return struct_with(name, &ty, doc.tokens(), lines, &items, out);
     }
+    let layout = if s.bits.is_empty() {
+        TokenStream::new()
+    } else {
+        layout.tokens()
+    };
     let doc = value_doc(entry, "The bit fields");
-    struct_with(name, &ty, doc.tokens(), layout.tokens(), &items, TokenStream::new())
+    struct_with(name, &ty, doc.tokens(), layout, &items, extra)
 }
 
-fn struct_with(name: &Ident, ty: &TokenStream, doc: TokenStream, layout: TokenStream, items: &[TokenStream], extra: TokenStream) -> TokenStream {
+fn struct_with(
+    name: &Ident,
+    ty: &TokenStream,
+    doc: TokenStream,
+    layout: TokenStream,
+    items: &[TokenStream],
+    extra: TokenStream,
+) -> TokenStream {
     quote! {
         #doc
-        #[doc = ""]
         #layout
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
         pub struct #name(pub #ty);
@@ -634,28 +801,54 @@ fn struct_with(name: &Ident, ty: &TokenStream, doc: TokenStream, layout: TokenSt
     }
 }
 
-fn bit_field_methods(field: &BitField, getter: &Ident, setter: &Ident, raw: Prim, enum_ident: Option<&Ident>) -> TokenStream {
+fn bit_field_methods(
+    field: &BitField,
+    getter: &Ident,
+    setter: &Ident,
+    raw: Prim,
+    enum_ident: Option<&Ident>,
+) -> TokenStream {
     let ty = raw.tokens();
     let uty = raw.unsigned().tokens();
     let lsb = proc_macro2::Literal::u32_unsuffixed(field.lsb);
     let mask = prim::hex((1u128 << field.width) - 1);
     let field_prim = Prim::int(false, field.width);
     let field_ty = field_prim.tokens();
-    let bits_text = if field.width == 1 { format!("Bit {}", field.lsb) } else { format!("Bits {}–{}", field.lsb, field.lsb + field.width - 1) };
+    let bits_text = if field.width == 1 {
+        format!("Bit {}", field.lsb)
+    } else {
+        format!("Bits {}–{}", field.lsb, field.lsb + field.width - 1)
+    };
     let mut doc = format!(" {bits_text}: {}", docs::text(&field.name));
     if let Some(text) = &field.text {
         doc.push_str(&format!(" — {}", docs::text(text)));
     }
     let set_doc = format!(" A copy with `{getter}` set.");
     // The raw value as its unsigned type (a cast only for signed raws).
-    let base = if raw.is_signed() { quote!((self.0 as #uty)) } else { quote!(self.0) };
-    let shifted = if field.lsb == 0 { base.clone() } else { quote!((#base >> #lsb)) };
+    let base = if raw.is_signed() {
+        quote!((self.0 as #uty))
+    } else {
+        quote!(self.0)
+    };
+    let shifted = if field.lsb == 0 {
+        base.clone()
+    } else {
+        quote!((#base >> #lsb))
+    };
     let bare = quote!(#shifted & #mask);
     let extract = quote!((#bare));
     // `value` (already of the unsigned raw type) placed into the field.
     let insert = |value: TokenStream| {
-        let placed = if field.lsb == 0 { quote!((#value & #mask)) } else { quote!(((#value & #mask) << #lsb)) };
-        let cleared = if field.lsb == 0 { quote!(#base & !#mask) } else { quote!(#base & !(#mask << #lsb)) };
+        let placed = if field.lsb == 0 {
+            quote!((#value & #mask))
+        } else {
+            quote!(((#value & #mask) << #lsb))
+        };
+        let cleared = if field.lsb == 0 {
+            quote!(#base & !#mask)
+        } else {
+            quote!(#base & !(#mask << #lsb))
+        };
         if raw.is_signed() {
             quote!(Self((#cleared | #placed) as #ty))
         } else {
@@ -663,10 +856,18 @@ fn bit_field_methods(field: &BitField, getter: &Ident, setter: &Ident, raw: Prim
         }
     };
     let widen = |value: TokenStream, from: Prim| {
-        if from == raw.unsigned() { value } else { quote!((#value as #uty)) }
+        if from == raw.unsigned() {
+            value
+        } else {
+            quote!((#value as #uty))
+        }
     };
     let narrow = |value: TokenStream| {
-        if field_prim == raw.unsigned() { bare.clone() } else { quote!(#value as #field_ty) }
+        if field_prim == raw.unsigned() {
+            bare.clone()
+        } else {
+            quote!(#value as #field_ty)
+        }
     };
     let mut out = if field.width == 1 {
         let ins = insert(quote!((value as #uty)));
@@ -697,10 +898,18 @@ fn bit_field_methods(field: &BitField, getter: &Ident, setter: &Ident, raw: Prim
     };
     if let Some(scale) = field.scale.filter(|s| s.is_finite()) {
         let value_fn = format_ident!("{}_value", getter.to_string().trim_end_matches('_'));
-        let unit = field.unit.as_deref().map(|u| format!(" in {}", docs::text(u))).unwrap_or_default();
+        let unit = field
+            .unit
+            .as_deref()
+            .map(|u| format!(" in {}", docs::text(u)))
+            .unwrap_or_default();
         let doc = format!(" The field's physical value{unit}: raw × {scale}.");
         let s = f64_lit(scale);
-        let raw_expr = if enum_ident.is_some() { quote!(self.#getter().to_raw()) } else { quote!(self.#getter()) };
+        let raw_expr = if enum_ident.is_some() {
+            quote!(self.#getter().to_raw())
+        } else {
+            quote!(self.#getter())
+        };
         out.extend(quote! {
             #[doc = #doc]
             pub const fn #value_fn(self) -> f64 { #raw_expr as f64 * #s }

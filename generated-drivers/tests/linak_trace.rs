@@ -1,0 +1,179 @@
+//! Golden tests from the LINAK manual's start-up trace (node 32, p. 28):
+//! the TPDO1 frames decode through the generated types to the values the
+//! manual states, and the commands encode to the frames it shows.
+
+use eds2rust_drivers::linak_techline::{self as linak, errors::LinakErrors, od, pdo};
+use eds2rust_runtime::od::{NodeId, PdoLengthError};
+
+fn node32() -> NodeId {
+    NodeId::new(linak::DEFAULT_NODE_ID).expect("32 is a node id")
+}
+
+fn position_mm(p: od::feedback::PositionValue) -> f64 {
+    match p {
+        od::feedback::PositionValue::Number(n) => n.value(),
+        other => panic!("position is not a number: {other:?}"),
+    }
+}
+
+fn current_a(c: od::feedback::CurrentValue) -> f64 {
+    match c {
+        od::feedback::CurrentValue::Number(n) => n.value(),
+        od::feedback::CurrentValue::NotRunning => 0.0,
+        other => panic!("current is not a number: {other:?}"),
+    }
+}
+
+fn speed_mm_s(s: od::feedback::SpeedValue) -> f64 {
+    match s {
+        od::feedback::SpeedValue::Number(n) => n.value(),
+        other => panic!("speed is not a number: {other:?}"),
+    }
+}
+
+#[test]
+fn cob_ids_of_node_32_are_the_traces() {
+    assert_eq!(pdo::Tpdo1Feedback::can_id(node32()), 0x1A0);
+    assert_eq!(pdo::Rpdo1Command::can_id(node32()), 0x220);
+    assert_eq!(linak::DEFAULT_BIT_RATE_KBIT, 250);
+}
+
+#[test]
+fn startup_frame_reports_power_up_lock() {
+    // "1A0 00 00 00 81 01 00 00 C0": TPDO1 before the first Stop command.
+    let fb = pdo::Tpdo1Feedback::decode(&[0x00, 0x00, 0x00, 0x81, 0x01, 0x00, 0x00, 0xC0]).unwrap();
+    assert_eq!(position_mm(fb.position), 0.0);
+    assert_eq!(fb.current, od::feedback::CurrentValue::NotRunning);
+    assert!(fb.status_flags.end_stop_in());
+    assert!(fb.status_flags.always_set());
+    assert!(!fb.status_flags.running_out() && !fb.status_flags.running_in());
+    assert_eq!(fb.error_code, LinakErrors::PowerUpLock);
+    assert_eq!(fb.error_code.code(), 1);
+    assert_eq!(
+        fb.error_code.remedy(),
+        Some("Send Stop (0xFB03) or Clear error (0xFB00)")
+    );
+    assert_eq!(speed_mm_s(fb.speed), 0.0);
+}
+
+#[test]
+fn running_out_at_2_6_mm() {
+    // "1A0 1A 00 06 88 00 31 00 C0": running out, 2.6 mm.
+    let fb = pdo::Tpdo1Feedback::decode(&[0x1A, 0x00, 0x06, 0x88, 0x00, 0x31, 0x00, 0xC0]).unwrap();
+    assert_eq!(position_mm(fb.position), 2.6);
+    assert_eq!(current_a(fb.current), 1.5);
+    assert!(fb.status_flags.running_out());
+    assert!(!fb.status_flags.running_in());
+    assert!(!fb.status_flags.end_stop_in() && !fb.status_flags.end_stop_out());
+    assert!(fb.status_flags.always_set());
+    assert_eq!(fb.error_code, LinakErrors::NoError);
+    assert_eq!(speed_mm_s(fb.speed), 4.9);
+    // AUX byte 0xC0: inputs 1-3 at 0-25 % VCC, input 4 at 76-100 % (level 3 × 25 %).
+    assert_eq!(fb.aux_inputs.input_level_1(), 0);
+    assert_eq!(fb.aux_inputs.input_level_3(), 0);
+    assert_eq!(fb.aux_inputs.input_level_4(), 3);
+    assert_eq!(fb.aux_inputs.input_level_4_value(), 75.0);
+}
+
+#[test]
+fn end_stop_out_at_50_3_mm() {
+    // "1A0 F7 01 00 82 00 00 00 C0": end stop outwards reached, 50.3 mm.
+    let fb = pdo::Tpdo1Feedback::decode(&[0xF7, 0x01, 0x00, 0x82, 0x00, 0x00, 0x00, 0xC0]).unwrap();
+    assert_eq!(position_mm(fb.position), 50.3);
+    assert_eq!(fb.current, od::feedback::CurrentValue::NotRunning);
+    assert!(fb.status_flags.end_stop_out());
+    assert!(!fb.status_flags.end_stop_in() && !fb.status_flags.running_out());
+    assert_eq!(fb.error_code, LinakErrors::NoError);
+    assert_eq!(speed_mm_s(fb.speed), 0.0);
+}
+
+#[test]
+fn running_in_at_9_6_mm() {
+    // "1A0 60 00 06 90 00 32 00 C0": running in, 9.6 mm.
+    let fb = pdo::Tpdo1Feedback::decode(&[0x60, 0x00, 0x06, 0x90, 0x00, 0x32, 0x00, 0xC0]).unwrap();
+    assert_eq!(position_mm(fb.position), 9.6);
+    assert_eq!(current_a(fb.current), 1.5);
+    assert!(fb.status_flags.running_in());
+    assert!(!fb.status_flags.running_out());
+    assert_eq!(fb.error_code, LinakErrors::NoError);
+    assert_eq!(speed_mm_s(fb.speed), 5.0);
+}
+
+#[test]
+fn end_stop_in_at_0_mm() {
+    // "1A0 00 00 00 81 00 00 00 C0": end stop inwards, 0 mm, no error.
+    let fb = pdo::Tpdo1Feedback::decode(&[0x00, 0x00, 0x00, 0x81, 0x00, 0x00, 0x00, 0xC0]).unwrap();
+    assert_eq!(position_mm(fb.position), 0.0);
+    assert!(fb.status_flags.end_stop_in());
+    assert_eq!(fb.error_code, LinakErrors::NoError);
+}
+
+fn command(position: od::command::PositionValue) -> pdo::Rpdo1Command {
+    use od::command::*;
+    pdo::Rpdo1Command {
+        position,
+        current_limit: CurrentLimitValue::Default,
+        speed: SpeedValue::Default,
+        soft_start: SoftStartValue::Default,
+        soft_stop: SoftStopValue::Default,
+        reserved_6: 0,
+        reserved_7: 0,
+    }
+}
+
+#[test]
+fn commands_encode_to_the_trace_frames() {
+    use od::command::PositionValue;
+    let stop = [0x03, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00];
+    let run_out = [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00];
+    let run_in = [0x02, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00];
+    assert_eq!(command(PositionValue::Stop).encode(), stop);
+    assert_eq!(command(PositionValue::RunOut).encode(), run_out);
+    assert_eq!(command(PositionValue::RunIn).encode(), run_in);
+    // And back: the frames decode to those commands.
+    assert_eq!(
+        pdo::Rpdo1Command::decode(&stop).unwrap(),
+        command(PositionValue::Stop)
+    );
+    assert_eq!(
+        pdo::Rpdo1Command::decode(&run_in).unwrap().position,
+        PositionValue::RunIn
+    );
+}
+
+#[test]
+fn position_setpoint_in_millimetres() {
+    use od::command::{PositionNumber, PositionValue};
+    let target = PositionNumber::from_value(12.3).expect("in range");
+    assert_eq!(target.to_raw(), 123);
+    let frame = command(PositionValue::Number(target)).encode();
+    assert_eq!(frame[..2], [123, 0]);
+    // 0xFB00 and up are commands, not positions: out of the numeric range.
+    assert_eq!(PositionNumber::from_value(6425.6), None);
+    assert_eq!(PositionNumber::from_value(-0.1), None);
+    assert_eq!(PositionNumber::from_value(f64::NAN), None);
+    assert_eq!(PositionValue::from_raw(0xFB00), PositionValue::ClearError);
+    assert_eq!(
+        PositionValue::from_raw(0xFB07),
+        PositionValue::Invalid(0xFB07)
+    );
+}
+
+#[test]
+fn short_and_long_frames_are_errors() {
+    assert_eq!(
+        pdo::Tpdo1Feedback::decode(&[0x00; 7]),
+        Err(PdoLengthError {
+            expected: 8,
+            actual: 7
+        })
+    );
+    assert_eq!(
+        pdo::Tpdo1Feedback::decode(&[0x00; 9]),
+        Err(PdoLengthError {
+            expected: 8,
+            actual: 9
+        })
+    );
+    assert!(pdo::Rpdo1Command::decode(&[]).is_err());
+}
