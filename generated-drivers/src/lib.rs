@@ -27,4 +27,9 @@ pub mod interroll_ec5000bi {
     include!(concat!(env!("OUT_DIR"), "/interroll_ec5000bi.rs"));
 }
 
+/// The example drive of the README, from the plain EDS `eds/example.eds`.
+pub mod example {
+    include!(concat!(env!("OUT_DIR"), "/example.rs"));
+}
+
 pub use eds2rust_runtime as runtime;

@@ -137,28 +137,35 @@ pub trait Read: Access {}
 )]
 pub trait Write: Access {}
 
-macro_rules! access_impls {
-    ($($ty:ident => $right:ident, read: $read:tt, write: $write:tt;)*) => {$(
-        impl Access for access::$ty {
-            const RIGHT: AccessRight = AccessRight::$right;
-        }
-        access_impls!(@read $read $ty);
-        access_impls!(@write $write $ty);
-    )*};
-    (@read true $ty:ident) => { impl Read for access::$ty {} };
-    (@read false $ty:ident) => {};
-    (@write true $ty:ident) => { impl Write for access::$ty {} };
-    (@write false $ty:ident) => {};
+impl Access for access::Ro {
+    const RIGHT: AccessRight = AccessRight::Ro;
+}
+impl Access for access::Wo {
+    const RIGHT: AccessRight = AccessRight::Wo;
+}
+impl Access for access::Rw {
+    const RIGHT: AccessRight = AccessRight::Rw;
+}
+impl Access for access::Rwr {
+    const RIGHT: AccessRight = AccessRight::Rwr;
+}
+impl Access for access::Rww {
+    const RIGHT: AccessRight = AccessRight::Rww;
+}
+impl Access for access::Const {
+    const RIGHT: AccessRight = AccessRight::Const;
 }
 
-access_impls! {
-    Ro => Ro, read: true, write: false;
-    Wo => Wo, read: false, write: true;
-    Rw => Rw, read: true, write: true;
-    Rwr => Rwr, read: true, write: true;
-    Rww => Rww, read: true, write: true;
-    Const => Const, read: true, write: false;
-}
+impl Read for access::Ro {}
+impl Read for access::Rw {}
+impl Read for access::Rwr {}
+impl Read for access::Rww {}
+impl Read for access::Const {}
+
+impl Write for access::Wo {}
+impl Write for access::Rw {}
+impl Write for access::Rwr {}
+impl Write for access::Rww {}
 
 /// One object-dictionary entry (a VAR, or one sub-entry of an ARRAY or
 /// RECORD), implemented by a generated zero-sized type.
