@@ -250,6 +250,9 @@ fn entry_items(
             }
         });
     }
+    if let Some(default_for) = node_default_tokens(rt, entry, plan) {
+        out.extend(quote!(impl #ident { #default_for }));
+    }
     let mut vcx = values::Ctx {
         rt,
         diags: cx.diags,
@@ -290,13 +293,7 @@ fn entry_doc(object: &Object, entry: &Entry, var: bool) -> Doc {
         }
         doc.para(line);
     }
-    let literal = |l: &Literal| {
-        if l.plus_node_id {
-            format!("$NODEID + {}", docs::text(&l.text))
-        } else {
-            docs::text(&l.text)
-        }
-    };
+    let literal = |l: &Literal| docs::text(&l.text);
     let mut facts = Vec::new();
     if let Some(d) = &entry.default {
         facts.push(format!("Default: {}", literal(d)));
@@ -333,6 +330,34 @@ fn default_tokens(entry: &Entry, plan: &Plan, value_ty: &TokenStream) -> Option<
         }
     };
     raw_literal(&literal.value, raw)
+}
+
+/// `default_for(node_id)` for a `$NODEID`-relative default of an integer
+/// entry (COB-IDs of EMCY, SDO and PDOs), when every node id fits the type.
+fn node_default_tokens(rt: &TokenStream, entry: &Entry, plan: &Plan) -> Option<TokenStream> {
+    let literal = entry.default.as_ref().filter(|l| l.plus_node_id)?;
+    let Plan::Prim(raw) = plan else {
+        return None;
+    };
+    let Value::Integer(offset) = literal.value else {
+        return None;
+    };
+    let (low, high) = raw.range();
+    if !raw.is_integer() || offset < low || offset + 127 > high {
+        return None;
+    }
+    let ty = raw.tokens();
+    let lit = raw.lit(offset);
+    let doc = format!(
+        " The default value for a node: {}.",
+        docs::text(&literal.text)
+    );
+    Some(quote! {
+        #[doc = #doc]
+        pub const fn default_for(node_id: #rt::od::NodeId) -> #ty {
+            #lit + node_id.get() as #ty
+        }
+    })
 }
 
 fn raw_literal(value: &Value, raw: Prim) -> Option<TokenStream> {

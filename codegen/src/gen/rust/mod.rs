@@ -5,7 +5,8 @@
 //! - identity constants at the top (vendor id, product code, default node id
 //!   and bit rate, ...);
 //! - `od`: one zero-sized type per entry ([`entries`]) with its value type
-//!   ([`values`]);
+//!   ([`values`] chooses it: an enum ([`enums`]), a bit-field struct
+//!   ([`bits`]), a scaled newtype ([`scaled`]) or a primitive ([`prim`]));
 //! - `errors`: one enum per device error table ([`errors`]);
 //! - `pdo`: one struct per default PDO ([`pdo`]).
 //!
@@ -14,12 +15,15 @@
 //! in index order and the file is formatted by prettyplease, so the same IR
 //! always gives the same bytes.
 
+mod bits;
 mod docs;
 mod entries;
+mod enums;
 mod errors;
 mod naming;
 mod pdo;
 mod prim;
+mod scaled;
 mod values;
 
 use proc_macro2::TokenStream;

@@ -355,7 +355,11 @@ fn emit_struct(
             f.target.index,
             f.target.subindex
         );
-        defs.push(quote!(#[doc = #field_doc] pub #name: #ty));
+        let alias = super::naming::alias_allowed(f.entry_name, names.text(f.name)).then(|| {
+            let source = f.entry_name;
+            quote!(#[doc(alias = #source)])
+        });
+        defs.push(quote!(#[doc = #field_doc] #alias pub #name: #ty));
         let mask = if f.width == 64 {
             u64::MAX
         } else {

@@ -1,0 +1,240 @@
+//! Enums over value tables: named values and ranges, an optional
+//! `Number(..)` variant for the numeric range, and the fallback (`other`)
+//! carrying the raw value, so that every raw value round-trips.
+
+use proc_macro2::{Ident, TokenStream};
+use quote::quote;
+
+use super::docs::{self, Doc};
+use super::naming::{Case, NameId, Namespace};
+use super::prim::Prim;
+use super::values::Ctx;
+use crate::ir::ValueTable;
+
+struct Variant<'a> {
+    name: NameId,
+    source: String,
+    text: Option<&'a str>,
+    /// Single raw values and inclusive ranges this variant stands for.
+    members: Vec<(i128, i128)>,
+    /// Carries the raw value (ranges, merged names, the fallback).
+    carries: bool,
+}
+
+/// An enum over a value table: named values, optionally `Number(..)` for the
+/// numeric range, and the fallback `other` carrying the raw value.
+pub(crate) fn value_enum(
+    cx: &mut Ctx,
+    name: &Ident,
+    raw: Prim,
+    table: &ValueTable,
+    doc: &Doc,
+    number: Option<(&TokenStream, bool)>,
+    owner: &str,
+) -> TokenStream {
+    let ty = raw.tokens();
+    let mut ns = Namespace::new(format!("enum `{name}` ({owner})"), Case::UpperCamel);
+    if table.numeric.is_some() {
+        ns.reserve("Number");
+    }
+    let mut variants: Vec<Variant> = Vec::new();
+    for named in &table.named {
+        match variants.iter_mut().find(|v| v.source == named.name) {
+            Some(v) => {
+                v.members.push((named.low, named.high));
+                v.carries = true;
+            }
+            None => variants.push(Variant {
+                name: ns.request(
+                    &named.name,
+                    &format!("raw {}", named.low),
+                    Some(&named.origin),
+                ),
+                source: named.name.clone(),
+                text: named.text.as_deref(),
+                members: vec![(named.low, named.high)],
+                carries: named.is_range(),
+            }),
+        }
+    }
+    let fallback = match variants.iter().position(|v| v.source == table.other) {
+        Some(i) => {
+            variants[i].carries = true;
+            i
+        }
+        None => {
+            variants.push(Variant {
+                name: ns.request(&table.other, "other", None),
+                source: table.other.clone(),
+                text: None,
+                members: Vec::new(),
+                carries: true,
+            });
+            variants.len() - 1
+        }
+    };
+    let names = ns.resolve(cx.diags);
+    let (number_ty, number_scaled) = number.unwrap_or((&ty, false));
+    let mut defs = Vec::new();
+    let mut from_arms = Vec::new();
+    let mut to_arms = Vec::new();
+    let mut name_arms = Vec::new();
+    let mut covered: Vec<(i128, i128)> = Vec::new();
+    if let Some((low, high)) = table.numeric {
+        defs.push(quote! {
+            #[doc = " A number (see the numeric range in the type's documentation)."]
+            Number(#number_ty)
+        });
+        let (l, h) = (raw.lit(low), raw.lit(high));
+        let wrap = if number_scaled {
+            quote!(Self::Number(#number_ty::from_raw(raw)))
+        } else {
+            quote!(Self::Number(raw))
+        };
+        from_arms.push(quote!(#l..=#h => #wrap));
+        to_arms.push(if number_scaled {
+            quote!(Self::Number(n) => n.to_raw())
+        } else {
+            quote!(Self::Number(n) => n)
+        });
+        name_arms.push(quote!(Self::Number(_) => "number"));
+        covered.push((low, high));
+    }
+    for (i, v) in variants.iter().enumerate() {
+        let ident = names.get(v.name);
+        let mut doc = Doc::new();
+        let raws: Vec<String> = v
+            .members
+            .iter()
+            .map(|&(l, h)| {
+                if l == h {
+                    format!("{l:#X}")
+                } else {
+                    format!("{l:#X}..={h:#X}")
+                }
+            })
+            .collect();
+        let mut head = format!("**{}**", docs::text(&v.source));
+        if !raws.is_empty() {
+            head.push_str(&format!(" (raw {})", raws.join(", ")));
+        }
+        if i == fallback {
+            head.push_str(if raws.is_empty() {
+                ": every raw value not covered by another variant"
+            } else {
+                "; also every raw value not covered by another variant"
+            });
+        }
+        doc.para(head);
+        if let Some(text) = v.text {
+            doc.source_para(text);
+        }
+        let doc = doc.tokens_with_alias(&v.source, names.text(v.name));
+        defs.push(if v.carries {
+            quote!(#doc #ident(#ty))
+        } else {
+            quote!(#doc #ident)
+        });
+        for &(low, high) in &v.members {
+            let (l, h) = (raw.lit(low), raw.lit(high));
+            let pattern = if low == high {
+                quote!(#l)
+            } else {
+                quote!(#l..=#h)
+            };
+            from_arms.push(if v.carries {
+                quote!(#pattern => Self::#ident(raw))
+            } else {
+                quote!(#pattern => Self::#ident)
+            });
+            covered.push((low, high));
+        }
+        if v.carries {
+            to_arms.push(quote!(Self::#ident(raw) => raw));
+        } else if let Some(&(low, _)) = v.members.first() {
+            let l = raw.lit(low);
+            to_arms.push(quote!(Self::#ident => #l));
+        }
+        let source = &v.source;
+        name_arms.push(if v.carries {
+            quote!(Self::#ident(_) => #source)
+        } else {
+            quote!(Self::#ident => #source)
+        });
+    }
+    let text_arms: Vec<TokenStream> = variants
+        .iter()
+        .map(|v| {
+            let ident = names.get(v.name);
+            let text = v.text.unwrap_or(&v.source);
+            if v.carries {
+                quote!(Self::#ident(_) => #text)
+            } else {
+                quote!(Self::#ident => #text)
+            }
+        })
+        .chain(table.numeric.map(|_| quote!(Self::Number(_) => "number")))
+        .collect();
+    let fallback_ident = names.get(variants[fallback].name);
+    if !covers(&mut covered, raw.range()) {
+        from_arms.push(quote!(_ => Self::#fallback_ident(raw)));
+    }
+    let has_float = number_scaled && raw.is_float();
+    let derives = if has_float {
+        quote!(#[derive(Debug, Clone, Copy, PartialEq)])
+    } else {
+        quote!(#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)])
+    };
+    let doc = doc.tokens();
+    quote! {
+        #doc
+        #derives
+        pub enum #name {
+            #(#defs,)*
+        }
+        impl #name {
+            #[doc = " The meaning of a raw value; every raw value has one."]
+            pub const fn from_raw(raw: #ty) -> Self {
+                match raw {
+                    #(#from_arms,)*
+                }
+            }
+            #[doc = " The raw value on the bus."]
+            pub const fn to_raw(self) -> #ty {
+                match self {
+                    #(#to_arms,)*
+                }
+            }
+            #[doc = " The name in the source."]
+            pub const fn name(self) -> &'static str {
+                match self {
+                    #(#name_arms,)*
+                }
+            }
+            #[doc = " The source's text for the value (its name when there is none)."]
+            pub const fn text(self) -> &'static str {
+                match self {
+                    #(#text_arms,)*
+                }
+            }
+        }
+    }
+}
+
+/// Whether the inclusive intervals cover `range` completely.
+fn covers(intervals: &mut [(i128, i128)], range: (i128, i128)) -> bool {
+    intervals.sort_unstable();
+    let mut next = range.0;
+    for &(low, high) in intervals.iter() {
+        if low > next {
+            return false;
+        }
+        if high >= next {
+            if high >= range.1 {
+                return true;
+            }
+            next = high + 1;
+        }
+    }
+    false
+}
