@@ -200,6 +200,7 @@ fn identity_items(device: &Device) -> TokenStream {
         .or(device.commissioning.as_ref().and_then(|c| c.node_id))
         .filter(|n| (1..=127).contains(n));
     if let Some(node_id) = node_id {
+        let node_id = proc_macro2::Literal::u8_unsuffixed(node_id);
         out.extend(quote! {
             #[doc = " Node id as delivered."]
             pub const DEFAULT_NODE_ID: u8 = #node_id;
@@ -210,6 +211,7 @@ fn identity_items(device: &Device) -> TokenStream {
         .bit_rate
         .or(device.commissioning.as_ref().and_then(|c| c.baud_rate));
     if let Some(bit_rate) = bit_rate {
+        let bit_rate = proc_macro2::Literal::u32_unsuffixed(bit_rate);
         out.extend(quote! {
             #[doc = " Bit rate as delivered, kbit/s."]
             pub const DEFAULT_BIT_RATE_KBIT: u32 = #bit_rate;
@@ -217,6 +219,7 @@ fn identity_items(device: &Device) -> TokenStream {
     }
     let rates = &device.capabilities.baud_rates;
     if !rates.is_empty() {
+        let rates = rates.iter().map(|r| proc_macro2::Literal::u32_unsuffixed(*r));
         out.extend(quote! {
             #[doc = " Supported bit rates, kbit/s."]
             pub const BIT_RATES_KBIT: &[u32] = &[#(#rates),*];
