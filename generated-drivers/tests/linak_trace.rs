@@ -10,25 +10,22 @@ fn node32() -> NodeId {
 }
 
 fn position_mm(p: od::feedback::PositionValue) -> f64 {
-    match p {
-        od::feedback::PositionValue::Number(n) => n.value(),
+    match p.kind() {
+        od::feedback::PositionKind::Number(n) => n.value(),
         other => panic!("position is not a number: {other:?}"),
     }
 }
 
 fn current_a(c: od::feedback::CurrentValue) -> f64 {
-    match c {
-        od::feedback::CurrentValue::Number(n) => n.value(),
-        od::feedback::CurrentValue::NotRunning => 0.0,
+    match c.kind() {
+        od::feedback::CurrentKind::Number(n) => n.value(),
+        od::feedback::CurrentKind::NotRunning => 0.0,
         other => panic!("current is not a number: {other:?}"),
     }
 }
 
 fn speed_mm_s(s: od::feedback::SpeedValue) -> f64 {
-    match s {
-        od::feedback::SpeedValue::Number(n) => n.value(),
-        other => panic!("speed is not a number: {other:?}"),
-    }
+    s.number().expect("speed is a number").value()
 }
 
 #[test]
@@ -38,8 +35,14 @@ fn cob_ids_of_node_32_are_the_traces() {
     assert_eq!(linak::DEFAULT_BIT_RATE_KBIT, 250);
     // $NODEID-relative defaults of other entries: EMCY and the SDO server.
     assert_eq!(od::CobIdEmcy::default_for(node32()), 0xA0);
-    assert_eq!(od::sdo_server_parameter::CobIdClientToServer::default_for(node32()), 0x620);
-    assert_eq!(od::sdo_server_parameter::CobIdServerToClient::default_for(node32()), 0x5A0);
+    assert_eq!(
+        od::sdo_server_parameter::CobIdClientToServer::default_for(node32()),
+        0x620
+    );
+    assert_eq!(
+        od::sdo_server_parameter::CobIdServerToClient::default_for(node32()),
+        0x5A0
+    );
 }
 
 #[test]
@@ -47,14 +50,14 @@ fn startup_frame_reports_power_up_lock() {
     // "1A0 00 00 00 81 01 00 00 C0": TPDO1 before the first Stop command.
     let fb = pdo::Tpdo1Feedback::decode(&[0x00, 0x00, 0x00, 0x81, 0x01, 0x00, 0x00, 0xC0]).unwrap();
     assert_eq!(position_mm(fb.position), 0.0);
-    assert_eq!(fb.current, od::feedback::CurrentValue::NotRunning);
+    assert_eq!(fb.current, od::feedback::CurrentValue::NOT_RUNNING);
     assert!(fb.status_flags.end_stop_in());
     assert!(fb.status_flags.always_set());
     assert!(!fb.status_flags.running_out() && !fb.status_flags.running_in());
-    assert_eq!(fb.error_code, LinakErrors::PowerUpLock);
-    assert_eq!(fb.error_code.code(), 1);
+    assert_eq!(fb.error_code.kind(), LinakErrors::PowerUpLock);
+    assert_eq!(fb.error_code.to_raw(), 1);
     assert_eq!(
-        fb.error_code.remedy(),
+        fb.error_code.kind().remedy(),
         Some("Send Stop (0xFB03) or Clear error (0xFB00)")
     );
     assert_eq!(speed_mm_s(fb.speed), 0.0);
@@ -70,7 +73,7 @@ fn running_out_at_2_6_mm() {
     assert!(!fb.status_flags.running_in());
     assert!(!fb.status_flags.end_stop_in() && !fb.status_flags.end_stop_out());
     assert!(fb.status_flags.always_set());
-    assert_eq!(fb.error_code, LinakErrors::NoError);
+    assert_eq!(fb.error_code.kind(), LinakErrors::NoError);
     assert_eq!(speed_mm_s(fb.speed), 4.9);
     // AUX byte 0xC0: inputs 1-3 at 0-25 % VCC, input 4 at 76-100 % (level 3 × 25 %).
     assert_eq!(fb.aux_inputs.input_level_1(), 0);
@@ -84,10 +87,10 @@ fn end_stop_out_at_50_3_mm() {
     // "1A0 F7 01 00 82 00 00 00 C0": end stop outwards reached, 50.3 mm.
     let fb = pdo::Tpdo1Feedback::decode(&[0xF7, 0x01, 0x00, 0x82, 0x00, 0x00, 0x00, 0xC0]).unwrap();
     assert_eq!(position_mm(fb.position), 50.3);
-    assert_eq!(fb.current, od::feedback::CurrentValue::NotRunning);
+    assert_eq!(fb.current, od::feedback::CurrentValue::NOT_RUNNING);
     assert!(fb.status_flags.end_stop_out());
     assert!(!fb.status_flags.end_stop_in() && !fb.status_flags.running_out());
-    assert_eq!(fb.error_code, LinakErrors::NoError);
+    assert_eq!(fb.error_code.kind(), LinakErrors::NoError);
     assert_eq!(speed_mm_s(fb.speed), 0.0);
 }
 
@@ -99,7 +102,7 @@ fn running_in_at_9_6_mm() {
     assert_eq!(current_a(fb.current), 1.5);
     assert!(fb.status_flags.running_in());
     assert!(!fb.status_flags.running_out());
-    assert_eq!(fb.error_code, LinakErrors::NoError);
+    assert_eq!(fb.error_code.kind(), LinakErrors::NoError);
     assert_eq!(speed_mm_s(fb.speed), 5.0);
 }
 
@@ -109,17 +112,17 @@ fn end_stop_in_at_0_mm() {
     let fb = pdo::Tpdo1Feedback::decode(&[0x00, 0x00, 0x00, 0x81, 0x00, 0x00, 0x00, 0xC0]).unwrap();
     assert_eq!(position_mm(fb.position), 0.0);
     assert!(fb.status_flags.end_stop_in());
-    assert_eq!(fb.error_code, LinakErrors::NoError);
+    assert_eq!(fb.error_code.kind(), LinakErrors::NoError);
 }
 
 fn command(position: od::command::PositionValue) -> pdo::Rpdo1Command {
     use od::command::*;
     pdo::Rpdo1Command {
         position,
-        current_limit: CurrentLimitValue::Default,
-        speed: SpeedValue::Default,
-        soft_start: SoftStartValue::Default,
-        soft_stop: SoftStopValue::Default,
+        current_limit: CurrentLimitValue::DEFAULT,
+        speed: SpeedValue::DEFAULT,
+        soft_start: SoftStartValue::DEFAULT,
+        soft_stop: SoftStopValue::DEFAULT,
         reserved_6: 0,
         reserved_7: 0,
     }
@@ -131,35 +134,36 @@ fn commands_encode_to_the_trace_frames() {
     let stop = [0x03, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00];
     let run_out = [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00];
     let run_in = [0x02, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00];
-    assert_eq!(command(PositionValue::Stop).encode(), stop);
-    assert_eq!(command(PositionValue::RunOut).encode(), run_out);
-    assert_eq!(command(PositionValue::RunIn).encode(), run_in);
+    assert_eq!(command(PositionValue::STOP).encode(), stop);
+    assert_eq!(command(PositionValue::RUN_OUT).encode(), run_out);
+    assert_eq!(command(PositionValue::RUN_IN).encode(), run_in);
     // And back: the frames decode to those commands.
     assert_eq!(
         pdo::Rpdo1Command::decode(&stop).unwrap(),
-        command(PositionValue::Stop)
+        command(PositionValue::STOP)
     );
     assert_eq!(
         pdo::Rpdo1Command::decode(&run_in).unwrap().position,
-        PositionValue::RunIn
+        PositionValue::RUN_IN
     );
 }
 
 #[test]
 fn position_setpoint_in_millimetres() {
-    use od::command::{PositionNumber, PositionValue};
+    use od::command::{PositionKind, PositionNumber, PositionValue};
     let target = PositionNumber::from_value(12.3).expect("in range");
     assert_eq!(target.to_raw(), 123);
-    let frame = command(PositionValue::Number(target)).encode();
+    let frame = command(PositionValue::from_number(target)).encode();
     assert_eq!(frame[..2], [123, 0]);
     // 0xFB00 and up are commands, not positions: out of the numeric range.
     assert_eq!(PositionNumber::from_value(6425.6), None);
     assert_eq!(PositionNumber::from_value(-0.1), None);
     assert_eq!(PositionNumber::from_value(f64::NAN), None);
-    assert_eq!(PositionValue::from_raw(0xFB00), PositionValue::ClearError);
+    assert_eq!(PositionValue::from_raw(0xFB00), PositionValue::CLEAR_ERROR);
+    assert_eq!(PositionValue::CLEAR_ERROR.kind(), PositionKind::ClearError);
     assert_eq!(
-        PositionValue::from_raw(0xFB07),
-        PositionValue::Invalid(0xFB07)
+        PositionValue::from_raw(0xFB07).kind(),
+        PositionKind::Invalid(0xFB07)
     );
 }
 

@@ -104,7 +104,7 @@ pub(crate) fn bit_struct(
             );
             items.push(quote! {
                 #[doc = #method_doc]
-                pub const fn #m(self) -> bool {
+                #[inline] pub const fn #m(self) -> bool {
                     #base & #mask == #value
                 }
             });
@@ -121,7 +121,7 @@ pub(crate) fn bit_struct(
         });
         items.push(quote! {
             #[doc = " The first named state whose pattern matches, if any."]
-            pub const fn state(self) -> Option<#state> {
+            #[inline] pub const fn state(self) -> Option<#state> {
                 #(#checks)*
                 None
             }
@@ -151,11 +151,11 @@ fn struct_with(
         pub struct #name(pub #ty);
         impl #name {
             #[doc = " The value with this raw form."]
-            pub const fn from_raw(raw: #ty) -> Self {
+            #[inline] pub const fn from_raw(raw: #ty) -> Self {
                 Self(raw)
             }
             #[doc = " The raw form on the bus."]
-            pub const fn to_raw(self) -> #ty {
+            #[inline] pub const fn to_raw(self) -> #ty {
                 self.0
             }
             #(#items)*
@@ -241,9 +241,9 @@ fn bit_field_methods(
         quote! {
             #[doc = #doc]
             #alias
-            pub const fn #getter(self) -> bool { #extract != 0 }
+            #[inline] pub const fn #getter(self) -> bool { #extract != 0 }
             #[doc = #set_doc]
-            pub const fn #setter(self, value: bool) -> Self { #ins }
+            #[inline] pub const fn #setter(self, value: bool) -> Self { #ins }
         }
     } else if let Some(enum_ident) = enum_ident {
         let ins = insert(widen(quote!(value.to_raw()), field_prim));
@@ -251,9 +251,9 @@ fn bit_field_methods(
         quote! {
             #[doc = #doc]
             #alias
-            pub const fn #getter(self) -> #enum_ident { #enum_ident::from_raw(#get) }
+            #[inline] pub const fn #getter(self) -> #enum_ident { #enum_ident::from_raw(#get) }
             #[doc = #set_doc]
-            pub const fn #setter(self, value: #enum_ident) -> Self { #ins }
+            #[inline] pub const fn #setter(self, value: #enum_ident) -> Self { #ins }
         }
     } else {
         let ins = insert(widen(quote!(value), field_prim));
@@ -261,9 +261,9 @@ fn bit_field_methods(
         quote! {
             #[doc = #doc]
             #alias
-            pub const fn #getter(self) -> #field_ty { #get }
+            #[inline] pub const fn #getter(self) -> #field_ty { #get }
             #[doc = #set_doc]
-            pub const fn #setter(self, value: #field_ty) -> Self { #ins }
+            #[inline] pub const fn #setter(self, value: #field_ty) -> Self { #ins }
         }
     };
     if let Some(scale) = field.scale.filter(|s| s.is_finite()) {
@@ -282,7 +282,7 @@ fn bit_field_methods(
         };
         out.extend(quote! {
             #[doc = #doc]
-            pub const fn #value_fn(self) -> f64 { #raw_expr as f64 * #s }
+            #[inline] pub const fn #value_fn(self) -> f64 { #raw_expr as f64 * #s }
         });
     }
     out

@@ -179,7 +179,10 @@ fn info(cx: &Ctx, module: &[Ident], plan: &Plan, names: &Names) -> EntryInfo {
         Plan::Error(i) => {
             let plan = &cx.errors[*i];
             (
-                Some(vec![super::naming::ident("errors"), plan.ident.clone()]),
+                Some(vec![
+                    super::naming::ident("errors"),
+                    plan.code_ident.clone(),
+                ]),
                 Some(plan.raw),
             )
         }
@@ -210,7 +213,7 @@ fn entry_items(
     let errors = cx.errors;
     let error_path = |i: usize| {
         rooted(
-            &[super::naming::ident("errors"), errors[i].ident.clone()],
+            &[super::naming::ident("errors"), errors[i].code_ident.clone()],
             depth,
         )
     };
@@ -322,11 +325,7 @@ fn default_tokens(entry: &Entry, plan: &Plan, value_ty: &TokenStream) -> Option<
         Plan::Error(_) | Plan::Enum { .. } | Plan::Bits { .. } | Plan::Scaled { .. } => {
             let raw_prim = Prim::of(entry.data_type)?;
             let lit = raw_literal(&literal.value, raw_prim)?;
-            let conv = match plan {
-                Plan::Error(_) => quote!(from_code),
-                _ => quote!(from_raw),
-            };
-            return Some(quote!(#value_ty::#conv(#lit)));
+            return Some(quote!(#value_ty::from_raw(#lit)));
         }
     };
     raw_literal(&literal.value, raw)
@@ -354,7 +353,7 @@ fn node_default_tokens(rt: &TokenStream, entry: &Entry, plan: &Plan) -> Option<T
     );
     Some(quote! {
         #[doc = #doc]
-        pub const fn default_for(node_id: #rt::od::NodeId) -> #ty {
+        #[inline] pub const fn default_for(node_id: #rt::od::NodeId) -> #ty {
             #lit + node_id.get() as #ty
         }
     })

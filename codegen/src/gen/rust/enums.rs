@@ -1,6 +1,8 @@
-//! Enums over value tables: named values and ranges, an optional
+//! Value tables: an enum of meanings (named values and ranges, an optional
 //! `Number(..)` variant for the numeric range, and the fallback (`other`)
-//! carrying the raw value, so that every raw value round-trips.
+//! carrying the raw value, so that every raw value round-trips) and, for
+//! entries, a newtype over the raw value that classifies on demand
+//! (`kind()`), so that PDO decoding and encoding stay shifts and masks.
 
 use proc_macro2::{Ident, TokenStream};
 use quote::quote;
@@ -21,8 +23,16 @@ struct Variant<'a> {
     carries: bool,
 }
 
+/// A named single value of a table, as a constant of the raw newtype.
+pub(crate) struct UnitValue {
+    pub(crate) variant: Ident,
+    pub(crate) source: String,
+    pub(crate) raw: i128,
+}
+
 /// An enum over a value table: named values, optionally `Number(..)` for the
-/// numeric range, and the fallback `other` carrying the raw value.
+/// numeric range, and the fallback `other` carrying the raw value. Also
+/// returns the variants that stand for one raw value.
 pub(crate) fn value_enum(
     cx: &mut Ctx,
     name: &Ident,
@@ -31,7 +41,7 @@ pub(crate) fn value_enum(
     doc: &Doc,
     number: Option<(&TokenStream, bool)>,
     owner: &str,
-) -> TokenStream {
+) -> (TokenStream, Vec<UnitValue>) {
     let ty = raw.tokens();
     let mut ns = Namespace::new(format!("enum `{name}` ({owner})"), Case::UpperCamel);
     if table.numeric.is_some() {
@@ -74,6 +84,17 @@ pub(crate) fn value_enum(
         }
     };
     let names = ns.resolve(cx.diags);
+    let units = variants
+        .iter()
+        .filter(|v| !v.carries)
+        .filter_map(|v| {
+            v.members.first().map(|&(low, _)| UnitValue {
+                variant: names.get(v.name),
+                source: v.source.clone(),
+                raw: low,
+            })
+        })
+        .collect();
     let (number_ty, number_scaled) = number.unwrap_or((&ty, false));
     let mut defs = Vec::new();
     let mut from_arms = Vec::new();
@@ -186,7 +207,7 @@ pub(crate) fn value_enum(
         quote!(#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)])
     };
     let doc = doc.tokens();
-    quote! {
+    let items = quote! {
         #doc
         #derives
         pub enum #name {
@@ -194,28 +215,139 @@ pub(crate) fn value_enum(
         }
         impl #name {
             #[doc = " The meaning of a raw value; every raw value has one."]
-            pub const fn from_raw(raw: #ty) -> Self {
+            #[inline] pub const fn from_raw(raw: #ty) -> Self {
                 match raw {
                     #(#from_arms,)*
                 }
             }
             #[doc = " The raw value on the bus."]
-            pub const fn to_raw(self) -> #ty {
+            #[inline] pub const fn to_raw(self) -> #ty {
                 match self {
                     #(#to_arms,)*
                 }
             }
             #[doc = " The name in the source."]
-            pub const fn name(self) -> &'static str {
+            #[inline] pub const fn name(self) -> &'static str {
                 match self {
                     #(#name_arms,)*
                 }
             }
             #[doc = " The source's text for the value (its name when there is none)."]
-            pub const fn text(self) -> &'static str {
+            #[inline] pub const fn text(self) -> &'static str {
                 match self {
                     #(#text_arms,)*
                 }
+            }
+        }
+    };
+    (items, units)
+}
+
+/// The value type of an entry with a value table: the raw value, with
+/// `kind()` giving its meaning (`kind` enum), a constant per named single
+/// value, and `number()` for the numeric range.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn raw_newtype(
+    cx: &mut Ctx,
+    name: &Ident,
+    kind: &Ident,
+    raw: Prim,
+    doc: &Doc,
+    number: Option<(&TokenStream, bool)>,
+    units: &[UnitValue],
+    owner: &str,
+) -> TokenStream {
+    let ty = raw.tokens();
+    let mut ns = Namespace::new(format!("impl `{name}` ({owner})"), Case::ShoutySnake);
+    let ids: Vec<NameId> = units
+        .iter()
+        .map(|u| ns.request(&u.source, &format!("raw {}", u.raw), None))
+        .collect();
+    let names = ns.resolve(cx.diags);
+    let consts = units.iter().zip(&ids).map(|(u, id)| {
+        let c = names.get(*id);
+        let v = &u.variant;
+        let lit = raw.lit(u.raw);
+        let doc = format!(" [`{kind}::{v}`] (raw {:#X}).", u.raw);
+        let alias = super::naming::alias_allowed(&u.source, names.text(*id)).then(|| {
+            let source = &u.source;
+            quote!(#[doc(alias = #source)])
+        });
+        quote!(#[doc = #doc] #alias pub const #c: Self = Self(#lit);)
+    });
+    let number_fns = number.map(|(number_ty, scaled)| {
+        let to = if scaled {
+            quote!(n.to_raw())
+        } else {
+            quote!(n)
+        };
+        quote! {
+            #[doc = " The number, when the raw value is in the numeric range."]
+            #[inline]
+            pub const fn number(self) -> Option<#number_ty> {
+                match self.kind() {
+                    #kind::Number(n) => Some(n),
+                    _ => None,
+                }
+            }
+            #[doc = " The value of a number."]
+            #[inline]
+            pub const fn from_number(n: #number_ty) -> Self {
+                Self(#to)
+            }
+        }
+    });
+    let doc = doc.tokens();
+    let kind_doc =
+        format!(" The meaning of the raw value (every raw value has one, see [`{kind}`]).");
+    quote! {
+        #doc
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        pub struct #name(pub #ty);
+        impl #name {
+            #(#consts)*
+            #[doc = " The value with this raw form."]
+            #[inline]
+            pub const fn from_raw(raw: #ty) -> Self {
+                Self(raw)
+            }
+            #[doc = " The raw form on the bus."]
+            #[inline]
+            pub const fn to_raw(self) -> #ty {
+                self.0
+            }
+            #[doc = #kind_doc]
+            #[inline]
+            pub const fn kind(self) -> #kind {
+                #kind::from_raw(self.0)
+            }
+            #[doc = " The value with this meaning."]
+            #[inline]
+            pub const fn from_kind(kind: #kind) -> Self {
+                Self(kind.to_raw())
+            }
+            #[doc = " The name in the source of the value's meaning."]
+            #[inline]
+            pub const fn name(self) -> &'static str {
+                self.kind().name()
+            }
+            #[doc = " The source's text for the value's meaning."]
+            #[inline]
+            pub const fn text(self) -> &'static str {
+                self.kind().text()
+            }
+            #number_fns
+        }
+        impl From<#kind> for #name {
+            #[inline]
+            fn from(kind: #kind) -> Self {
+                Self::from_kind(kind)
+            }
+        }
+        impl From<#name> for #kind {
+            #[inline]
+            fn from(value: #name) -> Self {
+                value.kind()
             }
         }
     }

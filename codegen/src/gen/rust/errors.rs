@@ -1,4 +1,6 @@
-//! Error-code enums: one per device error table, with the source's texts.
+//! Error tables: per device error table an enum of its codes with the
+//! source's texts, and a newtype over the raw code (the value type of the
+//! entries that report such codes) that classifies on demand (`kind()`).
 
 use proc_macro2::{Ident, TokenStream};
 use quote::quote;
@@ -12,7 +14,10 @@ use crate::ir::{Device, ErrorTable, ErrorTableKind};
 /// The generated enum of one error table.
 pub(crate) struct ErrorPlan {
     pub(crate) table: usize,
+    /// The enum of the codes.
     pub(crate) ident: Ident,
+    /// The newtype over a raw code.
+    pub(crate) code_ident: Ident,
     /// The code type: wide enough for every code and every entry that
     /// refers to the table.
     pub(crate) raw: Prim,
@@ -24,7 +29,12 @@ pub(crate) fn plan(device: &Device, diags: &mut Diagnostics) -> Vec<ErrorPlan> {
     let ids: Vec<_> = device
         .error_tables
         .iter()
-        .map(|t| ns.request(&t.name, "table", Some(&t.origin)))
+        .map(|t| {
+            (
+                ns.request(&t.name, "table", Some(&t.origin)),
+                ns.request(&format!("{} code", t.name), "table", Some(&t.origin)),
+            )
+        })
         .collect();
     let names = ns.resolve(diags);
     device
@@ -32,7 +42,7 @@ pub(crate) fn plan(device: &Device, diags: &mut Diagnostics) -> Vec<ErrorPlan> {
         .iter()
         .enumerate()
         .zip(ids)
-        .map(|((i, table), id)| {
+        .map(|((i, table), (id, code_id))| {
             let mut bits = match table.kind {
                 ErrorTableKind::Emcy => 16,
                 ErrorTableKind::SdoAbort => 32,
@@ -57,6 +67,7 @@ pub(crate) fn plan(device: &Device, diags: &mut Diagnostics) -> Vec<ErrorPlan> {
             ErrorPlan {
                 table: i,
                 ident: names.get(id),
+                code_ident: names.get(code_id),
                 raw: Prim::int(false, bits),
             }
         })
@@ -156,7 +167,11 @@ fn emit_table(
     };
     let reaction = optional(&reaction_arms);
     let remedy = optional(&remedy_arms);
-    let scalar = super::values::scalar_impl(rt, name, plan.raw);
+    let code_name = &plan.code_ident;
+    let scalar = super::values::scalar_impl(rt, code_name, plan.raw);
+    let code_doc = format!(
+        " A raw code of [`{name}`], as entries report it; [`Self::kind`] gives its meaning."
+    );
     let display_width = match plan.raw {
         Prim::U8 => 2usize,
         Prim::U16 => 4,
@@ -172,53 +187,83 @@ fn emit_table(
         }
         impl #name {
             #[doc = " The meaning of a code; every code has one."]
-            pub const fn from_code(code: #ty) -> Self {
+            #[inline] pub const fn from_code(code: #ty) -> Self {
                 match code {
                     #(#from_arms,)*
                     other => Self::Unknown(other),
                 }
             }
             #[doc = " The code on the bus."]
-            pub const fn code(self) -> #ty {
+            #[inline] pub const fn code(self) -> #ty {
                 match self {
                     #(#to_arms,)*
                     Self::Unknown(code) => code,
                 }
             }
-            #[doc = " The same as [`Self::from_code`]."]
-            pub const fn from_raw(raw: #ty) -> Self {
-                Self::from_code(raw)
-            }
-            #[doc = " The same as [`Self::code`]."]
-            pub const fn to_raw(self) -> #ty {
-                self.code()
-            }
             #[doc = " The code's name in the source (`\"unknown\"` for an unlisted code)."]
-            pub const fn name(self) -> &'static str {
+            #[inline] pub const fn name(self) -> &'static str {
                 match self {
                     #(#name_arms,)*
                     Self::Unknown(_) => "unknown",
                 }
             }
             #[doc = " The source's text for the code (its name when there is none)."]
-            pub const fn text(self) -> &'static str {
+            #[inline] pub const fn text(self) -> &'static str {
                 match self {
                     #(#text_arms,)*
                     Self::Unknown(_) => "code not listed in the error table",
                 }
             }
             #[doc = " What the device does, as the source says."]
-            pub const fn reaction(self) -> Option<&'static str> {
+            #[inline] pub const fn reaction(self) -> Option<&'static str> {
                 #reaction
             }
             #[doc = " What to do about it, as the source says."]
-            pub const fn remedy(self) -> Option<&'static str> {
+            #[inline] pub const fn remedy(self) -> Option<&'static str> {
                 #remedy
             }
         }
         impl core::fmt::Display for #name {
             fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
                 write!(f, "{:#0width$X} {}", self.code(), self.text(), width = #display_width + 2)
+            }
+        }
+        #[doc = #code_doc]
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+        pub struct #code_name(pub #ty);
+        impl #code_name {
+            #[doc = " The code with this raw form."]
+            #[inline] pub const fn from_raw(raw: #ty) -> Self {
+                Self(raw)
+            }
+            #[doc = " The raw code on the bus."]
+            #[inline] pub const fn to_raw(self) -> #ty {
+                self.0
+            }
+            #[doc = " The meaning of the code."]
+            #[inline] pub const fn kind(self) -> #name {
+                #name::from_code(self.0)
+            }
+            #[doc = " The code of a meaning."]
+            #[inline] pub const fn from_kind(kind: #name) -> Self {
+                Self(kind.code())
+            }
+        }
+        impl From<#name> for #code_name {
+            #[inline]
+            fn from(kind: #name) -> Self {
+                Self::from_kind(kind)
+            }
+        }
+        impl From<#code_name> for #name {
+            #[inline]
+            fn from(code: #code_name) -> Self {
+                code.kind()
+            }
+        }
+        impl core::fmt::Display for #code_name {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                core::fmt::Display::fmt(&self.kind(), f)
             }
         }
         #scalar

@@ -219,7 +219,9 @@ fn identity_items(device: &Device) -> TokenStream {
     }
     let rates = &device.capabilities.baud_rates;
     if !rates.is_empty() {
-        let rates = rates.iter().map(|r| proc_macro2::Literal::u32_unsuffixed(*r));
+        let rates = rates
+            .iter()
+            .map(|r| proc_macro2::Literal::u32_unsuffixed(*r));
         out.extend(quote! {
             #[doc = " Supported bit rates, kbit/s."]
             pub const BIT_RATES_KBIT: &[u32] = &[#(#rates),*];

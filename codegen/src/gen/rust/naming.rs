@@ -11,7 +11,7 @@
 
 use std::collections::BTreeMap;
 
-use heck::{ToSnakeCase, ToUpperCamelCase};
+use heck::{ToShoutySnakeCase, ToSnakeCase, ToUpperCamelCase};
 use proc_macro2::{Ident, Span};
 
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
@@ -24,6 +24,8 @@ pub(crate) enum Case {
     UpperCamel,
     /// Modules, fields, functions.
     Snake,
+    /// Constants.
+    ShoutySnake,
 }
 
 /// Rust's strict and reserved keywords (edition 2024) plus the names that
@@ -106,6 +108,7 @@ pub(crate) fn sanitize(text: &str, case: Case) -> String {
     let mut name = match case {
         Case::UpperCamel => ascii.to_upper_camel_case(),
         Case::Snake => ascii.to_snake_case(),
+        Case::ShoutySnake => ascii.to_shouty_snake_case(),
     };
     if name.is_empty() {
         return name;
@@ -116,6 +119,7 @@ pub(crate) fn sanitize(text: &str, case: Case) -> String {
             match case {
                 Case::UpperCamel => "N",
                 Case::Snake => "n_",
+                Case::ShoutySnake => "N_",
             },
         );
     }
@@ -269,7 +273,7 @@ impl Namespace {
 fn sep(case: Case) -> &'static str {
     match case {
         Case::UpperCamel => "",
-        Case::Snake => "_",
+        Case::Snake | Case::ShoutySnake => "_",
     }
 }
 

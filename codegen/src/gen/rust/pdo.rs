@@ -434,7 +434,7 @@ fn emit_struct(
             pub const LEN: usize = #len_lit;
             #cob
             #[doc = #decode_doc]
-            pub fn decode(data: &[u8]) -> Result<Self, #rt::od::PdoLengthError> {
+            #[inline] pub fn decode(data: &[u8]) -> Result<Self, #rt::od::PdoLengthError> {
                 let Ok(bytes) = <[u8; #len_lit]>::try_from(data) else {
                     return Err(#rt::od::PdoLengthError { expected: #len_lit, actual: data.len() });
                 };
@@ -442,7 +442,7 @@ fn emit_struct(
                 Ok(Self { #(#decodes,)* })
             }
             #[doc = #encode_doc]
-            pub fn encode(&self) -> [u8; #len_lit] {
+            #[inline] pub fn encode(&self) -> [u8; #len_lit] {
                 let mut word = 0u64;
                 #(#encodes)*
                 #bytes_from_word
@@ -454,10 +454,10 @@ fn emit_struct(
             const COMMUNICATION_INDEX: u16 = #comm_lit;
             const MAPPING_INDEX: u16 = #map_lit;
             const LEN: usize = #len_lit;
-            fn decode(data: &[u8]) -> Result<Self, #rt::od::PdoLengthError> {
+            #[inline] fn decode(data: &[u8]) -> Result<Self, #rt::od::PdoLengthError> {
                 Self::decode(data)
             }
-            fn encode_into(&self, out: &mut [u8; 8]) -> usize {
+            #[inline] fn encode_into(&self, out: &mut [u8; 8]) -> usize {
                 for (o, b) in out.iter_mut().zip(self.encode()) {
                     *o = b;
                 }
@@ -493,11 +493,11 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
         );
         quote! {
             #[doc = #doc]
-            pub const fn cob_id(node_id: #rt::od::NodeId) -> u32 {
+            #[inline] pub const fn cob_id(node_id: #rt::od::NodeId) -> u32 {
                 #value_lit + node_id.get() as u32
             }
             #[doc = " The CAN identifier of the default COB-ID for a node."]
-            pub const fn can_id(node_id: #rt::od::NodeId) -> u32 {
+            #[inline] pub const fn can_id(node_id: #rt::od::NodeId) -> u32 {
                 Self::cob_id(node_id) & #id_mask
             }
         }

@@ -89,7 +89,7 @@ pub(crate) fn scaled(
     let from_value = if raw.is_float() {
         quote! {
             #[doc = " The raw value for a physical value (no rounding: the raw type is a float)."]
-            pub const fn from_value(value: f64) -> Self {
+            #[inline] pub const fn from_value(value: f64) -> Self {
                 Self((#to_steps) as #ty)
             }
         }
@@ -101,7 +101,7 @@ pub(crate) fn scaled(
         );
         quote! {
             #[doc = #doc]
-            pub const fn from_value(value: f64) -> Option<Self> {
+            #[inline] pub const fn from_value(value: f64) -> Option<Self> {
                 let steps = #to_steps;
                 if !(steps > (Self::MIN_RAW as f64) - 1.0 && steps < (Self::MAX_RAW as f64) + 1.0) {
                     return None;
@@ -138,15 +138,15 @@ pub(crate) fn scaled(
             #[doc = " Physical value of raw 0."]
             pub const OFFSET: f64 = #offset_lit;
             #[doc = " The value with this raw form."]
-            pub const fn from_raw(raw: #ty) -> Self {
+            #[inline] pub const fn from_raw(raw: #ty) -> Self {
                 Self(raw)
             }
             #[doc = " The raw form on the bus."]
-            pub const fn to_raw(self) -> #ty {
+            #[inline] pub const fn to_raw(self) -> #ty {
                 self.0
             }
             #[doc = #value_fn_doc]
-            pub const fn value(self) -> f64 {
+            #[inline] pub const fn value(self) -> f64 {
                 #to_value + Self::OFFSET
             }
             #from_value

@@ -23,9 +23,11 @@ pub(crate) enum Plan {
     Bytes(&'static str),
     /// The error enum of a device error table (index into the error plans).
     Error(usize),
-    /// An enum over named values (and a numeric range, when `number`).
+    /// A newtype over the raw value (`name`) whose meaning is an enum over
+    /// named values (`kind`; and a numeric range, when `number`).
     Enum {
         name: NameId,
+        kind: NameId,
         raw: Prim,
         /// The newtype of the numeric part, when it has a unit or scale.
         number: Option<NameId>,
@@ -62,9 +64,15 @@ pub(crate) fn plan(entry: &Entry, error_plan: Option<usize>, ns: &mut Namespace)
         }
         if s.values.is_some() {
             let name = req(ns, "value");
+            let kind = req(ns, "kind");
             let number = (has_unit(s) && s.values.as_ref().is_some_and(|v| v.numeric.is_some()))
                 .then(|| req(ns, "number"));
-            return Plan::Enum { name, raw, number };
+            return Plan::Enum {
+                name,
+                kind,
+                raw,
+                number,
+            };
         }
         if !s.bits.is_empty() || !s.patterns.is_empty() {
             let name = req(ns, "value");
@@ -147,9 +155,15 @@ pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> T
             out.extend(scalar_impl(cx.rt, &name, *raw));
             out
         }
-        Plan::Enum { name, raw, number } => {
+        Plan::Enum {
+            name,
+            kind,
+            raw,
+            number,
+        } => {
             let table = s.values.as_ref().expect("planned only with a value table");
             let name = names.get(*name);
+            let kind = names.get(*kind);
             let mut out = TokenStream::new();
             let number_ty = match number {
                 Some(number) => {
@@ -161,14 +175,27 @@ pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> T
                 }
                 None => raw.tokens(),
             };
-            let doc = value_doc(entry, "The value");
-            out.extend(super::enums::value_enum(
+            let doc = value_doc(entry, "The meaning of the value");
+            let (kind_items, consts) = super::enums::value_enum(
                 cx,
-                &name,
+                &kind,
                 *raw,
                 table,
                 &doc,
                 Some((&number_ty, number.is_some())),
+                &entry.name,
+            );
+            out.extend(kind_items);
+            let doc = value_doc(entry, "The value");
+            let number = table.numeric.map(|_| (&number_ty, number.is_some()));
+            out.extend(super::enums::raw_newtype(
+                cx,
+                &name,
+                &kind,
+                *raw,
+                &doc,
+                number,
+                &consts,
                 &entry.name,
             ));
             out.extend(scalar_impl(cx.rt, &name, *raw));
@@ -199,7 +226,7 @@ pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> T
                         }
                         doc.origin(&field.origin);
                         let number_ty = field_raw.tokens();
-                        out.extend(super::enums::value_enum(
+                        let (items, _) = super::enums::value_enum(
                             cx,
                             &enum_ident,
                             field_raw,
@@ -207,7 +234,8 @@ pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> T
                             &doc,
                             Some((&number_ty, false)),
                             &field.name,
-                        ));
+                        );
+                        out.extend(items);
                         field_enums.push(Some(enum_ident));
                     }
                     _ => field_enums.push(None),
