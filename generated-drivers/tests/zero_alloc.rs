@@ -176,7 +176,7 @@ fn all_pdos() -> u64 {
 /// Value types: numbers with units, named values, bit fields, states, error
 /// tables and their `Display` into a fixed-size buffer.
 fn value_types(buf: &mut Buf) -> f64 {
-    use lk::od::{command, feedback};
+    use lk::od::command;
     let mut sum = 0.0;
     let position = command::PositionNumber::from_value(black_box(12.3)).expect("in range");
     sum += position.value() + f64::from(position.to_raw());
