@@ -108,7 +108,7 @@ pub(crate) fn bit_struct(
                     #base & #mask == #value
                 }
             });
-            checks.push(quote!(if self.#m() { return Some(#state::#v); }));
+            checks.push(quote!(if self.#m() { return ::core::option::Option::Some(#state::#v); }));
         }
         let doc = format!(
             " The named states of {} (masked patterns of the raw value).",
@@ -121,9 +121,9 @@ pub(crate) fn bit_struct(
         });
         items.push(quote! {
             #[doc = " The first named state whose pattern matches, if any."]
-            #[inline] pub const fn state(self) -> Option<#state> {
+            #[inline] pub const fn state(self) -> ::core::option::Option<#state> {
                 #(#checks)*
-                None
+                ::core::option::Option::None
             }
         });
     }

@@ -370,7 +370,17 @@ fn raw_literal(value: &Value, raw: Prim) -> Option<TokenStream> {
             let (low, high) = p.range();
             (low..=high).contains(v).then(|| p.lit(*v))
         }
-        (Value::Real(f), Prim::F32 | Prim::F64) if f.is_finite() => {
+        // An f32 is written as the shortest text that reads back as the same
+        // f32 (1.2, not its f64 widening 1.2000000476837158).
+        (Value::Real(f), Prim::F32) if (*f as f32).is_finite() => {
+            let lit = proc_macro2::Literal::f32_unsuffixed(f.abs() as f32);
+            Some(if *f < 0.0 {
+                quote!(-#lit)
+            } else {
+                quote!(#lit)
+            })
+        }
+        (Value::Real(f), Prim::F64) if f.is_finite() => {
             let lit = proc_macro2::Literal::f64_unsuffixed(f.abs());
             Some(if *f < 0.0 {
                 quote!(-#lit)

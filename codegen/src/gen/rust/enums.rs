@@ -284,10 +284,10 @@ pub(crate) fn raw_newtype(
         quote! {
             #[doc = " The number, when the raw value is in the numeric range."]
             #[inline]
-            pub const fn number(self) -> Option<#number_ty> {
+            pub const fn number(self) -> ::core::option::Option<#number_ty> {
                 match self.kind() {
-                    #kind::Number(n) => Some(n),
-                    _ => None,
+                    #kind::Number(n) => ::core::option::Option::Some(n),
+                    _ => ::core::option::Option::None,
                 }
             }
             #[doc = " The value of a number."]
@@ -338,13 +338,13 @@ pub(crate) fn raw_newtype(
             }
             #number_fns
         }
-        impl From<#kind> for #name {
+        impl ::core::convert::From<#kind> for #name {
             #[inline]
             fn from(kind: #kind) -> Self {
                 Self::from_kind(kind)
             }
         }
-        impl From<#name> for #kind {
+        impl ::core::convert::From<#name> for #kind {
             #[inline]
             fn from(value: #name) -> Self {
                 value.kind()

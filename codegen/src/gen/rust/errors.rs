@@ -140,10 +140,10 @@ fn emit_table(
         let text = code.text.as_deref().unwrap_or(&code.name);
         text_arms.push(quote!(Self::#v => #text));
         if let Some(reaction) = &code.reaction {
-            reaction_arms.push(quote!(Self::#v => Some(#reaction)));
+            reaction_arms.push(quote!(Self::#v => ::core::option::Option::Some(#reaction)));
         }
         if let Some(remedy) = &code.remedy {
-            remedy_arms.push(quote!(Self::#v => Some(#remedy)));
+            remedy_arms.push(quote!(Self::#v => ::core::option::Option::Some(#remedy)));
         }
     }
     let kind = match table.kind {
@@ -160,9 +160,9 @@ fn emit_table(
     let doc = doc.tokens_with_alias(&table.name, &name.to_string());
     let optional = |arms: &[TokenStream]| {
         if arms.is_empty() {
-            quote!(None)
+            quote!(::core::option::Option::None)
         } else {
-            quote!(match self { #(#arms,)* _ => None })
+            quote!(match self { #(#arms,)* _ => ::core::option::Option::None })
         }
     };
     let reaction = optional(&reaction_arms);
@@ -215,16 +215,16 @@ fn emit_table(
                 }
             }
             #[doc = " What the device does, as the source says."]
-            #[inline] pub const fn reaction(self) -> Option<&'static str> {
+            #[inline] pub const fn reaction(self) -> ::core::option::Option<&'static str> {
                 #reaction
             }
             #[doc = " What to do about it, as the source says."]
-            #[inline] pub const fn remedy(self) -> Option<&'static str> {
+            #[inline] pub const fn remedy(self) -> ::core::option::Option<&'static str> {
                 #remedy
             }
         }
-        impl core::fmt::Display for #name {
-            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        impl ::core::fmt::Display for #name {
+            fn fmt(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
                 write!(f, "{:#0width$X} {}", self.code(), self.text(), width = #display_width + 2)
             }
         }
@@ -249,21 +249,21 @@ fn emit_table(
                 Self(kind.code())
             }
         }
-        impl From<#name> for #code_name {
+        impl ::core::convert::From<#name> for #code_name {
             #[inline]
             fn from(kind: #name) -> Self {
                 Self::from_kind(kind)
             }
         }
-        impl From<#code_name> for #name {
+        impl ::core::convert::From<#code_name> for #name {
             #[inline]
             fn from(code: #code_name) -> Self {
                 code.kind()
             }
         }
-        impl core::fmt::Display for #code_name {
-            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-                core::fmt::Display::fmt(&self.kind(), f)
+        impl ::core::fmt::Display for #code_name {
+            fn fmt(&self, f: &mut ::core::fmt::Formatter<'_>) -> ::core::fmt::Result {
+                ::core::fmt::Display::fmt(&self.kind(), f)
             }
         }
         #scalar

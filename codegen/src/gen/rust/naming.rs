@@ -213,21 +213,22 @@ impl Namespace {
     }
 
     /// Resolves every request; collisions are reported into `diags`.
-    pub(crate) fn resolve(self, diags: &mut Diagnostics) -> Names {
+    pub(crate) fn resolve(mut self, diags: &mut Diagnostics) -> Names {
         let case = self.case;
+        // A source name with nothing usable is named by its key; that name
+        // takes part in the collision check like any other.
+        for r in &mut self.requests {
+            if r.base.is_empty() {
+                r.base = sanitize(&r.key, case);
+            }
+        }
         let qualified = |r: &Request| sanitize(&format!("{} {}", r.base, r.key), case);
         let mut groups: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
         for (i, r) in self.requests.iter().enumerate() {
-            if !r.base.is_empty() {
-                groups.entry(r.base.as_str()).or_default().push(i);
-            }
+            groups.entry(r.base.as_str()).or_default().push(i);
         }
         let mut names: Vec<String> = Vec::with_capacity(self.requests.len());
         for r in &self.requests {
-            if r.base.is_empty() {
-                names.push(qualified(r));
-                continue;
-            }
             let group = &groups[r.base.as_str()];
             let clash_reserved = self.reserved.contains(&r.base);
             names.push(if group.len() > 1 || clash_reserved {
@@ -254,15 +255,26 @@ impl Namespace {
             }
         }
         // Qualified names may still meet each other or a reserved name:
-        // number them, in request order.
+        // number them, in request order, and say so.
         let mut taken: Vec<String> = self.reserved.clone();
-        for name in &mut names {
+        for (i, name) in names.iter_mut().enumerate() {
             if taken.contains(name) {
                 let mut n = 2;
-                while taken.contains(&format!("{name}{}{n}", sep(case))) {
+                let numbered = |n: u32| format!("{name}{}N{n}", sep(case));
+                while taken.contains(&numbered(n)) {
                     n += 1;
                 }
-                *name = format!("{name}{}{n}", sep(case));
+                let new = numbered(n);
+                let r = &self.requests[i];
+                diags.push(diagnostic(
+                    r.origin.as_ref(),
+                    format!(
+                        "`{}` would be `{name}` in {}, which is taken even after qualifying; it is named `{new}`",
+                        r.source, self.scope
+                    ),
+                    Vec::new(),
+                ));
+                *name = new;
             }
             taken.push(name.clone());
         }
@@ -368,6 +380,8 @@ mod tests {
         let c = ns.request("Speed", "x2003", Some(&o(30)));
         let d = ns.request("unknown", "x2004", Some(&o(40)));
         let e = ns.request("🚀", "x2005", Some(&o(50)));
+        let f = ns.request("🚀", "sub 1", Some(&o(60)));
+        let g = ns.request("Sub1", "sub 2", Some(&o(70)));
         let mut diags = Diagnostics::new();
         let names = ns.resolve(&mut diags);
         assert_eq!(names.text(a), "ReservedX2001");
@@ -375,7 +389,10 @@ mod tests {
         assert_eq!(names.text(c), "Speed");
         assert_eq!(names.text(d), "UnknownX2004");
         assert_eq!(names.text(e), "X2005");
-        assert_eq!(diags.len(), 2);
+        // A key-made name meets a real one: both qualified, and reported.
+        assert_eq!(names.text(f), "Sub1Sub1");
+        assert_eq!(names.text(g), "Sub1Sub2");
+        assert_eq!(diags.len(), 3);
         let text = diags.to_string();
         assert!(
             text.contains("a.eds:10") && text.contains("a.eds:20"),

@@ -434,12 +434,12 @@ fn emit_struct(
             pub const LEN: usize = #len_lit;
             #cob
             #[doc = #decode_doc]
-            #[inline] pub fn decode(data: &[u8]) -> Result<Self, #rt::od::PdoLengthError> {
-                let Ok(bytes) = <[u8; #len_lit]>::try_from(data) else {
-                    return Err(#rt::od::PdoLengthError { expected: #len_lit, actual: data.len() });
+            #[inline] pub fn decode(data: &[u8]) -> ::core::result::Result<Self, #rt::od::PdoLengthError> {
+                let ::core::result::Result::Ok(bytes) = <[u8; #len_lit] as ::core::convert::TryFrom<&[u8]>>::try_from(data) else {
+                    return ::core::result::Result::Err(#rt::od::PdoLengthError { expected: #len_lit, actual: data.len() });
                 };
                 let word = #word_from_bytes;
-                Ok(Self { #(#decodes,)* })
+                ::core::result::Result::Ok(Self { #(#decodes,)* })
             }
             #[doc = #encode_doc]
             #[inline] pub fn encode(&self) -> [u8; #len_lit] {
@@ -454,7 +454,7 @@ fn emit_struct(
             const COMMUNICATION_INDEX: u16 = #comm_lit;
             const MAPPING_INDEX: u16 = #map_lit;
             const LEN: usize = #len_lit;
-            #[inline] fn decode(data: &[u8]) -> Result<Self, #rt::od::PdoLengthError> {
+            #[inline] fn decode(data: &[u8]) -> ::core::result::Result<Self, #rt::od::PdoLengthError> {
                 Self::decode(data)
             }
             #[inline] fn encode_into(&self, out: &mut [u8; 8]) -> usize {

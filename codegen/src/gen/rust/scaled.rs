@@ -101,10 +101,10 @@ pub(crate) fn scaled(
         );
         quote! {
             #[doc = #doc]
-            #[inline] pub const fn from_value(value: f64) -> Option<Self> {
+            #[inline] pub const fn from_value(value: f64) -> ::core::option::Option<Self> {
                 let steps = #to_steps;
                 if !(steps > (Self::MIN_RAW as f64) - 1.0 && steps < (Self::MAX_RAW as f64) + 1.0) {
-                    return None;
+                    return ::core::option::Option::None;
                 }
                 let truncated = steps as i128;
                 let fraction = steps - truncated as f64;
@@ -116,9 +116,9 @@ pub(crate) fn scaled(
                     truncated
                 };
                 if rounded < Self::MIN_RAW as i128 || rounded > Self::MAX_RAW as i128 {
-                    return None;
+                    return ::core::option::Option::None;
                 }
-                Some(Self(rounded as #ty))
+                ::core::option::Option::Some(Self(rounded as #ty))
             }
             #[doc = " The lowest raw value that is a number."]
             pub const MIN_RAW: #ty = #low_lit;
