@@ -144,20 +144,14 @@ fn struct_with(
     items: &[TokenStream],
     extra: TokenStream,
 ) -> TokenStream {
+    let raw_methods = super::values::raw_methods(ty);
     quote! {
         #doc
         #layout
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
         pub struct #name(pub #ty);
         impl #name {
-            #[doc = " The value with this raw form."]
-            #[inline] pub const fn from_raw(raw: #ty) -> Self {
-                Self(raw)
-            }
-            #[doc = " The raw form on the bus."]
-            #[inline] pub const fn to_raw(self) -> #ty {
-                self.0
-            }
+            #raw_methods
             #(#items)*
         }
         #extra

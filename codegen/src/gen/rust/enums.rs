@@ -300,22 +300,14 @@ pub(crate) fn raw_newtype(
     let doc = doc.tokens();
     let kind_doc =
         format!(" The meaning of the raw value (every raw value has one, see [`{kind}`]).");
+    let raw_methods = super::values::raw_methods(&ty);
     quote! {
         #doc
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
         pub struct #name(pub #ty);
         impl #name {
             #(#consts)*
-            #[doc = " The value with this raw form."]
-            #[inline]
-            pub const fn from_raw(raw: #ty) -> Self {
-                Self(raw)
-            }
-            #[doc = " The raw form on the bus."]
-            #[inline]
-            pub const fn to_raw(self) -> #ty {
-                self.0
-            }
+            #raw_methods
             #[doc = #kind_doc]
             #[inline]
             pub const fn kind(self) -> #kind {

@@ -177,6 +177,7 @@ fn emit_table(
         Prim::U16 => 4,
         _ => 8,
     };
+    let raw_methods = super::values::raw_methods(&ty);
     quote! {
         #doc
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -232,14 +233,7 @@ fn emit_table(
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
         pub struct #code_name(pub #ty);
         impl #code_name {
-            #[doc = " The code with this raw form."]
-            #[inline] pub const fn from_raw(raw: #ty) -> Self {
-                Self(raw)
-            }
-            #[doc = " The raw code on the bus."]
-            #[inline] pub const fn to_raw(self) -> #ty {
-                self.0
-            }
+            #raw_methods
             #[doc = " The meaning of the code."]
             #[inline] pub const fn kind(self) -> #name {
                 #name::from_code(self.0)

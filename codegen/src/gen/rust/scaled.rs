@@ -126,6 +126,7 @@ pub(crate) fn scaled(
             pub const MAX_RAW: #ty = #high_lit;
         }
     };
+    let raw_methods = super::values::raw_methods(&ty);
     quote! {
         #doc
         #derives
@@ -137,14 +138,7 @@ pub(crate) fn scaled(
             pub const SCALE: f64 = #scale_lit;
             #[doc = " Physical value of raw 0."]
             pub const OFFSET: f64 = #offset_lit;
-            #[doc = " The value with this raw form."]
-            #[inline] pub const fn from_raw(raw: #ty) -> Self {
-                Self(raw)
-            }
-            #[doc = " The raw form on the bus."]
-            #[inline] pub const fn to_raw(self) -> #ty {
-                self.0
-            }
+            #raw_methods
             #[doc = #value_fn_doc]
             #[inline] pub const fn value(self) -> f64 {
                 #to_value + Self::OFFSET

@@ -278,6 +278,22 @@ fn unit_doc(doc: &mut Doc, s: &Semantics) {
     doc.para(format!("{line}."));
 }
 
+/// `from_raw`/`to_raw` of a newtype over the raw value (`Self(pub raw)`).
+pub(crate) fn raw_methods(ty: &TokenStream) -> TokenStream {
+    quote! {
+        #[doc = " The value with this raw form."]
+        #[inline]
+        pub const fn from_raw(raw: #ty) -> Self {
+            Self(raw)
+        }
+        #[doc = " The raw form on the bus."]
+        #[inline]
+        pub const fn to_raw(self) -> #ty {
+            self.0
+        }
+    }
+}
+
 /// `impl Scalar` for a generated type with inherent `from_raw`/`to_raw`.
 pub(crate) fn scalar_impl(rt: &TokenStream, name: &Ident, raw: Prim) -> TokenStream {
     let ty = raw.tokens();
