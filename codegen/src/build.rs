@@ -436,9 +436,19 @@ fn write_if_changed(path: &Path, bytes: &[u8]) -> std::io::Result<bool> {
     if std::fs::read(path).is_ok_and(|old| old == bytes) {
         return Ok(false);
     }
+    write_whole(path, bytes)?;
+    Ok(true)
+}
+
+/// Writes `bytes` to a temporary file beside `path` (creating the directory
+/// when missing) and renames it over `path`, so that a reader never sees
+/// half a file. Used for every output file the crate writes.
+pub fn write_whole(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
     static COUNTER: AtomicU64 = AtomicU64::new(0);
     let dir = path.parent().unwrap_or(Path::new(""));
-    std::fs::create_dir_all(dir)?;
+    if !dir.as_os_str().is_empty() {
+        std::fs::create_dir_all(dir)?;
+    }
     let mut tmp_name = std::ffi::OsString::from(".");
     tmp_name.push(path.file_name().unwrap_or_default());
     tmp_name.push(format!(
@@ -451,8 +461,7 @@ fn write_if_changed(path: &Path, bytes: &[u8]) -> std::io::Result<bool> {
         .and_then(|()| std::fs::rename(&tmp, path))
         .inspect_err(|_| {
             let _ = std::fs::remove_file(&tmp);
-        })?;
-    Ok(true)
+        })
 }
 
 /// A failed [`Builder`] run: every diagnostic of every device (warnings

@@ -177,14 +177,18 @@ impl Diagnostics {
                         .with_notes(d.notes.iter().map(|n| printable(n)).collect())
                 }
                 _ => {
-                    // No source position: a one-line rendering that still names the file.
+                    // No source text to show: a one-line rendering that still names the
+                    // file and, when known, the line.
                     out.push_str(&format!(
                         "{}[{}]: {}\n",
                         d.severity.as_str(),
                         d.code,
                         printable(&d.headline())
                     ));
-                    out.push_str(&format!("  = in {}\n", d.file));
+                    match d.location.line {
+                        Some(line) => out.push_str(&format!("  = in {}:{line}\n", d.file)),
+                        None => out.push_str(&format!("  = in {}\n", d.file)),
+                    }
                     for note in &d.notes {
                         out.push_str(&format!("  = {note}\n"));
                     }

@@ -243,7 +243,7 @@ fn write_output(output: Option<&std::path::Path>, text: &str) -> ExitCode {
             let _ = std::io::stdout().lock().write_all(text.as_bytes());
             ExitCode::SUCCESS
         }
-        Some(out) => match write_whole(out, text.as_bytes()) {
+        Some(out) => match eds2rust::build::write_whole(out, text.as_bytes()) {
             Ok(()) => ExitCode::SUCCESS,
             Err(err) => {
                 let _ = writeln!(
@@ -255,16 +255,4 @@ fn write_output(output: Option<&std::path::Path>, text: &str) -> ExitCode {
             }
         },
     }
-}
-
-/// Writes `bytes` to a temporary file beside `path` and renames it over
-/// `path`, so that a reader never sees half a file.
-fn write_whole(path: &std::path::Path, bytes: &[u8]) -> std::io::Result<()> {
-    let mut tmp = path.as_os_str().to_owned();
-    tmp.push(".tmp");
-    let tmp = PathBuf::from(tmp);
-    std::fs::write(&tmp, bytes)?;
-    std::fs::rename(&tmp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&tmp);
-    })
 }

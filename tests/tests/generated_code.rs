@@ -37,6 +37,11 @@ const SEEDS: &[&str] = &[
 /// The hostile fixture, relative to the workspace root (also its display name).
 const HOSTILE: &str = "codegen/tests/fixtures/hostile.eds";
 
+/// A YAML table whose objects, values and error table are named like the core
+/// items generated code uses (`Option`, `Some`, `Result`, `From`, `core`):
+/// compiled with the rest, it shows those names cannot shadow them.
+const SHADOWING: &str = "codegen/tests/fixtures/shadowing.yaml";
+
 /// Corpus files (../shared/eds-corpus/files) whose generated code is
 /// snapshotted, chosen for variety.
 const CORPUS_SNAPSHOTS: &[&str] = &[
@@ -331,8 +336,8 @@ fn clippy(dir: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// Every corpus file, the seeds and the hostile fixture compile together,
-/// clippy-clean. Without ../shared the seeds and the fixture still do.
+/// Every corpus file, the seeds and the hostile and shadowing fixtures compile
+/// together, clippy-clean. Without ../shared the seeds and the fixtures still do.
 #[test]
 fn generated_code_compiles_under_clippy() {
     let started = Instant::now();
@@ -346,9 +351,10 @@ fn generated_code_compiles_under_clippy() {
         })
         .collect();
     inputs.push((HOSTILE.to_string(), workspace_root().join(HOSTILE)));
+    inputs.push((SHADOWING.to_string(), workspace_root().join(SHADOWING)));
     let own = inputs.len();
     if let Some(files) = corpus_files(
-        "generated-code compile check of the corpus (the seeds and the hostile fixture still ran)",
+        "generated-code compile check of the corpus (the seeds and the fixtures still ran)",
     ) {
         inputs.extend(
             files

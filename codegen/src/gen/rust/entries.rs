@@ -70,6 +70,7 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
     // Names in `od`: types of VAR objects (and their value types), modules of
     // the others.
     let mut types = Namespace::new("module `od`", Case::UpperCamel);
+    types.reserve_constructor_names();
     let mut modules = Namespace::new("module `od`", Case::Snake);
     let mut root_plans = Vec::new();
     let mut module_ids = Vec::new();
@@ -113,6 +114,7 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
         let module = module_names.get(id);
         let path = vec![super::naming::ident("od"), module.clone()];
         let mut ns = Namespace::new(format!("module `od::{module}`"), Case::UpperCamel);
+        ns.reserve_constructor_names();
         let plans: Vec<_> = object
             .entries
             .values()

@@ -26,6 +26,7 @@ pub(crate) struct ErrorPlan {
 /// Names the enums (in module `errors`) and sizes their code types.
 pub(crate) fn plan(device: &Device, diags: &mut Diagnostics) -> Vec<ErrorPlan> {
     let mut ns = Namespace::new("module `errors`", Case::UpperCamel);
+    ns.reserve_constructor_names();
     let ids: Vec<_> = device
         .error_tables
         .iter()

@@ -193,6 +193,15 @@ impl Namespace {
         }
     }
 
+    /// Reserves the type names whose snake case is a constructor generated
+    /// types have (`FromValue` vs `from_value`): a type of that name would
+    /// make its constructor look like a self-named one.
+    pub(crate) fn reserve_constructor_names(&mut self) {
+        for name in ["FromRaw", "FromValue", "FromKind", "FromNumber", "FromCode"] {
+            self.reserve(name);
+        }
+    }
+
     /// A name the generator itself uses in this scope (a method, a fixed
     /// variant); a source name that becomes equal to it is qualified.
     pub(crate) fn reserve(&mut self, name: &str) {
