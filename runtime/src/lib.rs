@@ -1,14 +1,48 @@
 //! eds2rust-runtime: the thin CANopen runtime that generated drivers talk through.
 //!
-//! Now:
 //! - [`od`]: the object-dictionary traits and types that generated code
 //!   implements (entries as zero-sized types with type-level access rights,
 //!   value conversion, PDO structs, node ids). Needs only `core`.
+//! - [`frame`], [`time`]: classic CAN frames, CANopen identifiers, and the
+//!   caller-supplied clock of the protocol cores.
+//! - Protocol cores, sans-IO (fed frames and the current time; they return
+//!   frames to send, events and their next deadline through [`Service`]):
+//!   [`sdo`] (client and server: expedited, segmented, block).
 //!
-//! To come (issues 5 and 6 of the project plan): sans-IO protocol cores fed
-//! with frames and time (NMT, heartbeat, SDO client and server, PDO engine,
-//! SYNC, EMCY, LSS master, a CiA 402 helper) and transports (Linux SocketCAN,
-//! any `embedded-can` device, an in-process virtual bus with simulators).
-#![no_std]
+//! Features: `std` (default) and `alloc` (SDO buffers); `tokio`,
+//! `socketcan` (Linux) and `embedded-can` for the transports.
+#![cfg_attr(not(test), no_std)]
 
+#[cfg(feature = "alloc")]
+extern crate alloc;
+#[cfg(all(feature = "std", not(test)))]
+extern crate std;
+
+pub mod frame;
 pub mod od;
+pub mod sdo;
+pub mod time;
+
+pub use frame::{CanId, Frame};
+pub use time::Instant;
+
+/// The interface every sans-IO protocol core offers (the style of
+/// quinn-proto): the caller feeds received frames and the current time, then
+/// drains frames to send and events, and calls [`Service::handle_timeout`]
+/// once the clock reaches [`Service::poll_timeout`].
+///
+/// Cores ignore frames that are not theirs, so a driver may feed every frame
+/// on the bus to every core.
+pub trait Service {
+    type Event;
+    /// A frame was received at `now`.
+    fn handle_frame(&mut self, now: Instant, frame: &Frame);
+    /// The clock reached (or passed) the deadline of [`Service::poll_timeout`].
+    fn handle_timeout(&mut self, now: Instant);
+    /// The next frame to send, if any. Call until `None` after every input.
+    fn poll_transmit(&mut self) -> Option<Frame>;
+    /// The next event, if any. Call until `None` after every input.
+    fn poll_event(&mut self) -> Option<Self::Event>;
+    /// The earliest instant at which [`Service::handle_timeout`] must be called.
+    fn poll_timeout(&self) -> Option<Instant>;
+}

@@ -1,0 +1,628 @@
+//! The bytes of SDO frames (CiA 301 SDO protocols): every request a client
+//! sends and every response a server sends, parsed and built here and only
+//! here. Segments of a block transfer carry no command specifier, so they
+//! have their own type, [`BlockSegment`], that the state machines use while a
+//! sub-block is in flight.
+//!
+//! CiA 301 fixes the length of every SDO frame at 8 bytes; [`Request::parse`]
+//! and [`Response::parse`] refuse other lengths.
+
+use core::fmt;
+
+use super::AbortCode;
+
+/// Data of an initiate request or response.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Initiate {
+    /// Expedited: up to 4 bytes in the frame. `len` is 4 when the sender did
+    /// not indicate the size.
+    Expedited { data: [u8; 4], len: u8 },
+    /// Segmented: the data follows in segments; the total size when indicated.
+    Segmented { size: Option<u32> },
+}
+
+/// A frame from SDO client to SDO server.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Request {
+    DownloadInitiate {
+        index: u16,
+        sub: u8,
+        data: Initiate,
+    },
+    DownloadSegment {
+        toggle: bool,
+        last: bool,
+        data: [u8; 7],
+        len: u8,
+    },
+    UploadInitiate {
+        index: u16,
+        sub: u8,
+    },
+    UploadSegment {
+        toggle: bool,
+    },
+    BlockDownloadInitiate {
+        index: u16,
+        sub: u8,
+        crc: bool,
+        size: Option<u32>,
+    },
+    /// `unused`: bytes of the last segment that carry no data (0 to 7).
+    BlockDownloadEnd {
+        unused: u8,
+        crc: u16,
+    },
+    /// `pst`: protocol switch threshold (0: the server must not switch).
+    BlockUploadInitiate {
+        index: u16,
+        sub: u8,
+        crc: bool,
+        block_size: u8,
+        pst: u8,
+    },
+    BlockUploadStart,
+    BlockUploadAck {
+        ack_seq: u8,
+        block_size: u8,
+    },
+    BlockUploadEnd,
+    Abort {
+        index: u16,
+        sub: u8,
+        code: AbortCode,
+    },
+}
+
+/// A frame from SDO server to SDO client.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Response {
+    DownloadInitiate {
+        index: u16,
+        sub: u8,
+    },
+    DownloadSegment {
+        toggle: bool,
+    },
+    UploadInitiate {
+        index: u16,
+        sub: u8,
+        data: Initiate,
+    },
+    UploadSegment {
+        toggle: bool,
+        last: bool,
+        data: [u8; 7],
+        len: u8,
+    },
+    BlockDownloadInitiate {
+        index: u16,
+        sub: u8,
+        crc: bool,
+        block_size: u8,
+    },
+    BlockDownloadAck {
+        ack_seq: u8,
+        block_size: u8,
+    },
+    BlockDownloadEnd,
+    BlockUploadInitiate {
+        index: u16,
+        sub: u8,
+        crc: bool,
+        size: Option<u32>,
+    },
+    /// `unused`: bytes of the last segment that carry no data (0 to 7).
+    BlockUploadEnd {
+        unused: u8,
+        crc: u16,
+    },
+    Abort {
+        index: u16,
+        sub: u8,
+        code: AbortCode,
+    },
+}
+
+/// One segment of a block: sequence number 1 to 127, a last-segment flag and
+/// 7 bytes (the last segment's unused bytes are told by the end frame).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BlockSegment {
+    pub seq: u8,
+    pub last: bool,
+    pub data: [u8; 7],
+}
+
+/// Why a frame is not a valid SDO frame.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum ParseError {
+    /// Not 8 data bytes (or a remote frame).
+    Length(usize),
+    /// An unknown command specifier or sub-command.
+    Command(u8),
+    /// A field out of range (a segment length, a sequence number of 0 or 128+).
+    Field(u8),
+}
+
+impl ParseError {
+    /// The abort code a peer answers this error with.
+    pub const fn abort_code(self) -> AbortCode {
+        AbortCode::InvalidCommand
+    }
+}
+
+impl fmt::Display for ParseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ParseError::Length(n) => write!(f, "SDO frame has {n} data bytes, not 8"),
+            ParseError::Command(b) => write!(f, "unknown SDO command byte {b:#04x}"),
+            ParseError::Field(b) => write!(f, "SDO command byte {b:#04x} has a field out of range"),
+        }
+    }
+}
+
+fn eight(data: &[u8]) -> Result<&[u8; 8], ParseError> {
+    data.try_into().map_err(|_| ParseError::Length(data.len()))
+}
+
+fn address(d: &[u8; 8]) -> (u16, u8) {
+    (u16::from_le_bytes([d[1], d[2]]), d[3])
+}
+
+fn put_address(d: &mut [u8; 8], index: u16, sub: u8) {
+    d[1..3].copy_from_slice(&index.to_le_bytes());
+    d[3] = sub;
+}
+
+fn u32_at(d: &[u8; 8]) -> u32 {
+    u32::from_le_bytes([d[4], d[5], d[6], d[7]])
+}
+
+fn bit(b: u8, n: u8) -> bool {
+    b >> n & 1 != 0
+}
+
+/// Initiate (download request or upload response): `e` bit 1, `s` bit 0,
+/// `n` bits 3-2.
+fn parse_initiate(d: &[u8; 8]) -> Initiate {
+    let b = d[0];
+    let (expedited, sized) = (bit(b, 1), bit(b, 0));
+    if expedited {
+        let len = if sized { 4 - (b >> 2 & 3) } else { 4 };
+        Initiate::Expedited {
+            data: [d[4], d[5], d[6], d[7]],
+            len,
+        }
+    } else {
+        Initiate::Segmented {
+            size: sized.then(|| u32_at(d)),
+        }
+    }
+}
+
+fn put_initiate(d: &mut [u8; 8], data: &Initiate) {
+    match *data {
+        Initiate::Expedited { data, len } => {
+            let len = len.clamp(1, 4);
+            d[0] |= (4 - len) << 2 | 0b11;
+            d[4..8].copy_from_slice(&data);
+            // Bytes beyond the length are zero on the bus.
+            for b in &mut d[4 + len as usize..8] {
+                *b = 0;
+            }
+        }
+        Initiate::Segmented { size } => {
+            if let Some(size) = size {
+                d[0] |= 1;
+                d[4..8].copy_from_slice(&size.to_le_bytes());
+            }
+        }
+    }
+}
+
+/// Segment (download request or upload response): `t` bit 4, `n` bits 3-1,
+/// `c` bit 0.
+fn parse_segment(d: &[u8; 8]) -> (bool, bool, [u8; 7], u8) {
+    let b = d[0];
+    let mut data = [0u8; 7];
+    data.copy_from_slice(&d[1..8]);
+    (bit(b, 4), bit(b, 0), data, 7 - (b >> 1 & 7))
+}
+
+fn put_segment(d: &mut [u8; 8], toggle: bool, last: bool, data: &[u8; 7], len: u8) {
+    let len = len.min(7);
+    d[0] |= (toggle as u8) << 4 | (7 - len) << 1 | last as u8;
+    d[1..1 + len as usize].copy_from_slice(&data[..len as usize]);
+}
+
+fn put_abort(d: &mut [u8; 8], index: u16, sub: u8, code: AbortCode) {
+    d[0] = 0x80;
+    put_address(d, index, sub);
+    d[4..8].copy_from_slice(&code.code().to_le_bytes());
+}
+
+impl Request {
+    pub fn parse(data: &[u8]) -> Result<Request, ParseError> {
+        let d = eight(data)?;
+        let b = d[0];
+        let (index, sub) = address(d);
+        Ok(match b >> 5 {
+            0 => {
+                let (toggle, last, data, len) = parse_segment(d);
+                Request::DownloadSegment {
+                    toggle,
+                    last,
+                    data,
+                    len,
+                }
+            }
+            1 => Request::DownloadInitiate {
+                index,
+                sub,
+                data: parse_initiate(d),
+            },
+            2 => Request::UploadInitiate { index, sub },
+            3 => Request::UploadSegment { toggle: bit(b, 4) },
+            4 => Request::Abort {
+                index,
+                sub,
+                code: AbortCode::from_code(u32_at(d)),
+            },
+            5 => match b & 3 {
+                0 => Request::BlockUploadInitiate {
+                    index,
+                    sub,
+                    crc: bit(b, 2),
+                    block_size: d[4],
+                    pst: d[5],
+                },
+                1 => Request::BlockUploadEnd,
+                2 => Request::BlockUploadAck {
+                    ack_seq: d[1],
+                    block_size: d[2],
+                },
+                _ => Request::BlockUploadStart,
+            },
+            6 => {
+                if b & 1 == 0 {
+                    Request::BlockDownloadInitiate {
+                        index,
+                        sub,
+                        crc: bit(b, 2),
+                        size: bit(b, 1).then(|| u32_at(d)),
+                    }
+                } else {
+                    Request::BlockDownloadEnd {
+                        unused: b >> 2 & 7,
+                        crc: u16::from_le_bytes([d[1], d[2]]),
+                    }
+                }
+            }
+            _ => return Err(ParseError::Command(b)),
+        })
+    }
+
+    pub fn encode(&self) -> [u8; 8] {
+        let mut d = [0u8; 8];
+        match *self {
+            Request::DownloadInitiate {
+                index,
+                sub,
+                ref data,
+            } => {
+                d[0] = 0x20;
+                put_address(&mut d, index, sub);
+                put_initiate(&mut d, data);
+            }
+            Request::DownloadSegment {
+                toggle,
+                last,
+                ref data,
+                len,
+            } => {
+                put_segment(&mut d, toggle, last, data, len);
+            }
+            Request::UploadInitiate { index, sub } => {
+                d[0] = 0x40;
+                put_address(&mut d, index, sub);
+            }
+            Request::UploadSegment { toggle } => d[0] = 0x60 | (toggle as u8) << 4,
+            Request::BlockDownloadInitiate {
+                index,
+                sub,
+                crc,
+                size,
+            } => {
+                d[0] = 0xC0 | (crc as u8) << 2 | (size.is_some() as u8) << 1;
+                put_address(&mut d, index, sub);
+                d[4..8].copy_from_slice(&size.unwrap_or(0).to_le_bytes());
+            }
+            Request::BlockDownloadEnd { unused, crc } => {
+                d[0] = 0xC1 | (unused & 7) << 2;
+                d[1..3].copy_from_slice(&crc.to_le_bytes());
+            }
+            Request::BlockUploadInitiate {
+                index,
+                sub,
+                crc,
+                block_size,
+                pst,
+            } => {
+                d[0] = 0xA0 | (crc as u8) << 2;
+                put_address(&mut d, index, sub);
+                d[4] = block_size;
+                d[5] = pst;
+            }
+            Request::BlockUploadStart => d[0] = 0xA3,
+            Request::BlockUploadAck {
+                ack_seq,
+                block_size,
+            } => {
+                d[0] = 0xA2;
+                d[1] = ack_seq;
+                d[2] = block_size;
+            }
+            Request::BlockUploadEnd => d[0] = 0xA1,
+            Request::Abort { index, sub, code } => put_abort(&mut d, index, sub, code),
+        }
+        d
+    }
+}
+
+impl Response {
+    pub fn parse(data: &[u8]) -> Result<Response, ParseError> {
+        let d = eight(data)?;
+        let b = d[0];
+        let (index, sub) = address(d);
+        Ok(match b >> 5 {
+            0 => {
+                let (toggle, last, data, len) = parse_segment(d);
+                Response::UploadSegment {
+                    toggle,
+                    last,
+                    data,
+                    len,
+                }
+            }
+            1 => Response::DownloadSegment { toggle: bit(b, 4) },
+            2 => Response::UploadInitiate {
+                index,
+                sub,
+                data: parse_initiate(d),
+            },
+            3 => Response::DownloadInitiate { index, sub },
+            4 => Response::Abort {
+                index,
+                sub,
+                code: AbortCode::from_code(u32_at(d)),
+            },
+            5 => match b & 3 {
+                0 => Response::BlockDownloadInitiate {
+                    index,
+                    sub,
+                    crc: bit(b, 2),
+                    block_size: d[4],
+                },
+                1 => Response::BlockDownloadEnd,
+                2 => Response::BlockDownloadAck {
+                    ack_seq: d[1],
+                    block_size: d[2],
+                },
+                _ => return Err(ParseError::Command(b)),
+            },
+            6 => {
+                if b & 1 == 0 {
+                    Response::BlockUploadInitiate {
+                        index,
+                        sub,
+                        crc: bit(b, 2),
+                        size: bit(b, 1).then(|| u32_at(d)),
+                    }
+                } else {
+                    Response::BlockUploadEnd {
+                        unused: b >> 2 & 7,
+                        crc: u16::from_le_bytes([d[1], d[2]]),
+                    }
+                }
+            }
+            _ => return Err(ParseError::Command(b)),
+        })
+    }
+
+    pub fn encode(&self) -> [u8; 8] {
+        let mut d = [0u8; 8];
+        match *self {
+            Response::DownloadInitiate { index, sub } => {
+                d[0] = 0x60;
+                put_address(&mut d, index, sub);
+            }
+            Response::DownloadSegment { toggle } => d[0] = 0x20 | (toggle as u8) << 4,
+            Response::UploadInitiate {
+                index,
+                sub,
+                ref data,
+            } => {
+                d[0] = 0x40;
+                put_address(&mut d, index, sub);
+                put_initiate(&mut d, data);
+            }
+            Response::UploadSegment {
+                toggle,
+                last,
+                ref data,
+                len,
+            } => {
+                put_segment(&mut d, toggle, last, data, len);
+            }
+            Response::BlockDownloadInitiate {
+                index,
+                sub,
+                crc,
+                block_size,
+            } => {
+                d[0] = 0xA0 | (crc as u8) << 2;
+                put_address(&mut d, index, sub);
+                d[4] = block_size;
+            }
+            Response::BlockDownloadAck {
+                ack_seq,
+                block_size,
+            } => {
+                d[0] = 0xA2;
+                d[1] = ack_seq;
+                d[2] = block_size;
+            }
+            Response::BlockDownloadEnd => d[0] = 0xA1,
+            Response::BlockUploadInitiate {
+                index,
+                sub,
+                crc,
+                size,
+            } => {
+                d[0] = 0xC0 | (crc as u8) << 2 | (size.is_some() as u8) << 1;
+                put_address(&mut d, index, sub);
+                d[4..8].copy_from_slice(&size.unwrap_or(0).to_le_bytes());
+            }
+            Response::BlockUploadEnd { unused, crc } => {
+                d[0] = 0xC1 | (unused & 7) << 2;
+                d[1..3].copy_from_slice(&crc.to_le_bytes());
+            }
+            Response::Abort { index, sub, code } => put_abort(&mut d, index, sub, code),
+        }
+        d
+    }
+}
+
+impl BlockSegment {
+    /// Parses a segment. A first byte of 0x80 (sequence number 0 with the
+    /// last flag) is how an abort looks; callers check for it with
+    /// [`BlockSegment::is_abort`] first.
+    pub fn parse(data: &[u8]) -> Result<BlockSegment, ParseError> {
+        let d = eight(data)?;
+        let seq = d[0] & 0x7F;
+        if seq == 0 {
+            return Err(ParseError::Field(d[0]));
+        }
+        let mut bytes = [0u8; 7];
+        bytes.copy_from_slice(&d[1..8]);
+        Ok(BlockSegment {
+            seq,
+            last: bit(d[0], 7),
+            data: bytes,
+        })
+    }
+
+    /// Whether a frame received during a sub-block is an abort instead of a segment.
+    pub fn is_abort(data: &[u8]) -> bool {
+        data.len() == 8 && data[0] == 0x80
+    }
+
+    pub fn encode(&self) -> [u8; 8] {
+        let mut d = [0u8; 8];
+        d[0] = (self.last as u8) << 7 | (self.seq & 0x7F);
+        d[1..8].copy_from_slice(&self.data);
+        d
+    }
+}
+
+/// CRC-16 of block transfers: CCITT polynomial 0x1021, initial value 0, no
+/// reflection (the "XMODEM" parameters).
+pub const CRC: crc::Crc<u16> = crc::Crc::<u16>::new(&crc::CRC_16_XMODEM);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn expedited_download_of_two_bytes() {
+        // Written from CiA 301: ccs=1, n=2, e=1, s=1 -> 0x2B.
+        let r = Request::DownloadInitiate {
+            index: 0x1017,
+            sub: 0,
+            data: Initiate::Expedited {
+                data: [0xE8, 0x03, 0, 0],
+                len: 2,
+            },
+        };
+        assert_eq!(r.encode(), [0x2B, 0x17, 0x10, 0x00, 0xE8, 0x03, 0, 0]);
+        assert_eq!(Request::parse(&r.encode()), Ok(r));
+    }
+
+    #[test]
+    fn known_command_bytes() {
+        assert_eq!(
+            Request::UploadInitiate {
+                index: 0x1000,
+                sub: 0
+            }
+            .encode()[0],
+            0x40
+        );
+        assert_eq!(
+            Response::DownloadInitiate { index: 1, sub: 0 }.encode()[0],
+            0x60
+        );
+        // Expedited upload response of 4 bytes: 0x43.
+        let r = Response::UploadInitiate {
+            index: 0x1000,
+            sub: 0,
+            data: Initiate::Expedited {
+                data: [0x92, 0x01, 0x02, 0x00],
+                len: 4,
+            },
+        };
+        assert_eq!(r.encode(), [0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00]);
+        // Segmented upload response with size: 0x41.
+        let r = Response::UploadInitiate {
+            index: 0x1008,
+            sub: 0,
+            data: Initiate::Segmented { size: Some(10) },
+        };
+        assert_eq!(r.encode(), [0x41, 0x08, 0x10, 0x00, 10, 0, 0, 0]);
+        // Last upload segment with 3 bytes, toggle 1: 0x1 << 4 | (7-3) << 1 | 1 = 0x19.
+        let r = Response::UploadSegment {
+            toggle: true,
+            last: true,
+            data: [1, 2, 3, 0, 0, 0, 0],
+            len: 3,
+        };
+        assert_eq!(r.encode(), [0x19, 1, 2, 3, 0, 0, 0, 0]);
+        assert_eq!(Request::BlockUploadStart.encode()[0], 0xA3);
+        let r = Request::BlockDownloadInitiate {
+            index: 0x1F50,
+            sub: 1,
+            crc: true,
+            size: Some(0x100),
+        };
+        assert_eq!(r.encode(), [0xC6, 0x50, 0x1F, 0x01, 0x00, 0x01, 0x00, 0x00]);
+        let a = Request::Abort {
+            index: 0x2000,
+            sub: 1,
+            code: AbortCode::WriteReadOnly,
+        };
+        assert_eq!(a.encode(), [0x80, 0x00, 0x20, 0x01, 0x02, 0x00, 0x01, 0x06]);
+    }
+
+    #[test]
+    fn crc_matches_the_ccitt_check_value() {
+        // The CRC catalogue's check value of CRC-16/XMODEM over "123456789".
+        assert_eq!(CRC.checksum(b"123456789"), 0x31C3);
+    }
+
+    #[test]
+    fn wrong_length_and_unknown_commands_are_errors() {
+        assert_eq!(Request::parse(&[0x40, 0, 0]), Err(ParseError::Length(3)));
+        assert_eq!(
+            Request::parse(&[0xE0, 0, 0, 0, 0, 0, 0, 0]),
+            Err(ParseError::Command(0xE0))
+        );
+        assert_eq!(
+            Response::parse(&[0xA3, 0, 0, 0, 0, 0, 0, 0]),
+            Err(ParseError::Command(0xA3))
+        );
+        assert_eq!(
+            BlockSegment::parse(&[0x80, 0, 0, 0, 0, 0, 0, 0]),
+            Err(ParseError::Field(0x80))
+        );
+    }
+}
