@@ -18,10 +18,22 @@ extern crate alloc;
 #[cfg(all(feature = "std", not(test)))]
 extern crate std;
 
+pub mod emcy;
 pub mod frame;
+pub mod guarding;
+pub mod heartbeat;
+pub mod nmt;
 pub mod od;
 pub mod sdo;
+pub mod sync;
 pub mod time;
+
+#[cfg(feature = "std")]
+pub mod blocking;
+#[cfg(feature = "tokio")]
+pub mod tokio;
+#[cfg(feature = "std")]
+pub mod transport;
 
 pub use frame::{CanId, Frame};
 pub use time::Instant;

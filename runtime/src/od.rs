@@ -260,6 +260,55 @@ pub mod bytes {
     pub enum Opaque {}
 }
 
+/// Value types read and written as a byte sequence of any length (the
+/// markers of [`bytes`]); SDO drivers offer byte-buffer access for them.
+pub trait ByteValue: sealed::Sealed {
+    /// The CiA 301 data type the marker stands for (DOMAIN for [`bytes::Opaque`]).
+    const DATA_TYPE: DataType;
+}
+
+impl sealed::Sealed for bytes::VisibleString {}
+impl sealed::Sealed for bytes::OctetString {}
+impl sealed::Sealed for bytes::UnicodeString {}
+impl sealed::Sealed for bytes::Domain {}
+impl sealed::Sealed for bytes::Opaque {}
+impl ByteValue for bytes::VisibleString {
+    const DATA_TYPE: DataType = DataType::VisibleString;
+}
+impl ByteValue for bytes::OctetString {
+    const DATA_TYPE: DataType = DataType::OctetString;
+}
+impl ByteValue for bytes::UnicodeString {
+    const DATA_TYPE: DataType = DataType::UnicodeString;
+}
+impl ByteValue for bytes::Domain {
+    const DATA_TYPE: DataType = DataType::Domain;
+}
+impl ByteValue for bytes::Opaque {
+    const DATA_TYPE: DataType = DataType::Domain;
+}
+
+/// A device's error table, as generated from its EDS/YAML `errors:` section
+/// (an enum with one variant per listed code and a fallback for the rest).
+/// The EMCY consumer uses it to name the codes a device reports.
+pub trait ErrorTable: Copy + fmt::Debug + fmt::Display {
+    /// Looks a code up; a code wider than the table's code type, or not
+    /// listed, gives the fallback variant.
+    fn lookup(code: u32) -> Self;
+    /// The numeric code.
+    fn code(self) -> u32;
+    /// Whether the code is listed in the table.
+    fn is_known(self) -> bool;
+    /// The short name from the table.
+    fn name(self) -> &'static str;
+    /// The description from the table.
+    fn text(self) -> &'static str;
+    /// The device's reaction, when the table states one.
+    fn reaction(self) -> Option<&'static str>;
+    /// What to do about it, when the table states it.
+    fn remedy(self) -> Option<&'static str>;
+}
+
 /// Why a value could not be encoded or decoded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ValueError {
