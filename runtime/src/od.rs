@@ -292,11 +292,11 @@ impl ByteValue for bytes::Opaque {
 /// (an enum with one variant per listed code and a fallback for the rest).
 /// The EMCY consumer uses it to name the codes a device reports.
 pub trait ErrorTable: Copy + fmt::Debug + fmt::Display {
-    /// Looks a code up; a code wider than the table's code type, or not
-    /// listed, gives the fallback variant.
-    fn lookup(code: u32) -> Self;
+    /// Looks a code up: `None` when it does not fit the table's code type,
+    /// the fallback variant when the table does not list it.
+    fn lookup(code: u64) -> Option<Self>;
     /// The numeric code.
-    fn code(self) -> u32;
+    fn code(self) -> u64;
     /// Whether the code is listed in the table.
     fn is_known(self) -> bool;
     /// The short name from the table.

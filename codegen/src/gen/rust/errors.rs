@@ -230,6 +230,39 @@ fn emit_table(
                 write!(f, "{:#0width$X} {}", self.code(), self.text(), width = #display_width + 2)
             }
         }
+        impl #rt::od::ErrorTable for #name {
+            #[inline]
+            fn lookup(code: u64) -> ::core::option::Option<Self> {
+                match <#ty as ::core::convert::TryFrom<u64>>::try_from(code) {
+                    ::core::result::Result::Ok(code) => ::core::option::Option::Some(Self::from_code(code)),
+                    ::core::result::Result::Err(_) => ::core::option::Option::None,
+                }
+            }
+            #[inline]
+            fn code(self) -> u64 {
+                self.code() as u64
+            }
+            #[inline]
+            fn is_known(self) -> bool {
+                !::core::matches!(self, Self::Unknown(_))
+            }
+            #[inline]
+            fn name(self) -> &'static str {
+                self.name()
+            }
+            #[inline]
+            fn text(self) -> &'static str {
+                self.text()
+            }
+            #[inline]
+            fn reaction(self) -> ::core::option::Option<&'static str> {
+                self.reaction()
+            }
+            #[inline]
+            fn remedy(self) -> ::core::option::Option<&'static str> {
+                self.remedy()
+            }
+        }
         #[doc = #code_doc]
         #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
         pub struct #code_name(pub #ty);
