@@ -1,1 +1,492 @@
-//! (being written)
+//! Blocking drivers: run sans-IO cores over a [`Bus`] on the calling thread.
+//!
+//! - [`drive`] runs any [`Service`] until a closure over its events says
+//!   stop, or a deadline passes; [`serve`] runs one until a stop flag is set
+//!   (simulators, test peers).
+//! - [`SdoClient`] reads and writes objects of one node through
+//!   [`crate::sdo::client::SdoClient`]: raw bytes, or typed through the
+//!   generated [`od::Entry`] types.
+
+use core::fmt;
+use core::ops::ControlFlow;
+use core::time::Duration;
+use std::io;
+use std::string::String;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::vec::Vec;
+
+use crate::od::{self, Entry};
+use crate::sdo::client::{self, ClientConfig, ClientEvent, Method};
+use crate::sdo::{AbortCode, SdoError};
+use crate::transport::{Bus, Clock};
+use crate::{Instant, Service};
+
+/// How often [`serve`] looks at its stop flag while nothing happens.
+pub const STOP_POLL: Duration = Duration::from_millis(10);
+
+/// Longest single wait when neither the core nor the caller set a deadline.
+const IDLE_WAIT: Duration = Duration::from_secs(1);
+
+/// Why [`drive`] returned without a result.
+#[derive(Debug)]
+pub enum DriveError {
+    /// The bus failed.
+    Io(io::Error),
+    /// The deadline passed.
+    Deadline,
+    /// The stop flag was set.
+    Stopped,
+}
+
+impl fmt::Display for DriveError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            DriveError::Io(e) => write!(f, "CAN bus error: {e}"),
+            DriveError::Deadline => f.write_str("the deadline passed"),
+            DriveError::Stopped => f.write_str("stopped"),
+        }
+    }
+}
+
+impl std::error::Error for DriveError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            DriveError::Io(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// Runs `service` on `bus`: sends what it transmits, feeds it every
+/// received frame and its timeouts (times from `clock`), and hands each of
+/// its events to `until`. Returns the value `until` breaks with, or
+/// [`DriveError::Deadline`] once `deadline` passes first.
+///
+/// Events left in the service when `until` breaks stay there for the next
+/// call.
+pub fn drive<B, S, T>(
+    bus: &mut B,
+    clock: &Clock,
+    service: &mut S,
+    mut until: impl FnMut(S::Event) -> ControlFlow<T>,
+    deadline: std::time::Instant,
+) -> Result<T, DriveError>
+where
+    B: Bus + ?Sized,
+    S: Service + ?Sized,
+{
+    run(bus, clock, service, &mut until, Some(deadline), None)
+}
+
+/// Runs `service` on `bus` (as [`drive`] does) until `stop` is set or
+/// `deadline` passes, handing every event to `on_event`. `stop` is checked
+/// at least every [`STOP_POLL`]. Returns `Ok(())` when stopped or past the
+/// deadline, the bus error otherwise.
+pub fn serve<B, S>(
+    bus: &mut B,
+    clock: &Clock,
+    service: &mut S,
+    stop: &AtomicBool,
+    deadline: Option<std::time::Instant>,
+    mut on_event: impl FnMut(S::Event),
+) -> io::Result<()>
+where
+    B: Bus + ?Sized,
+    S: Service + ?Sized,
+{
+    let mut until = |event| -> ControlFlow<()> {
+        on_event(event);
+        ControlFlow::Continue(())
+    };
+    match run(bus, clock, service, &mut until, deadline, Some(stop)) {
+        Ok(()) | Err(DriveError::Deadline | DriveError::Stopped) => Ok(()),
+        Err(DriveError::Io(e)) => Err(e),
+    }
+}
+
+/// The loop behind [`drive`] and [`serve`].
+fn run<B, S, T>(
+    bus: &mut B,
+    clock: &Clock,
+    service: &mut S,
+    until: &mut impl FnMut(S::Event) -> ControlFlow<T>,
+    deadline: Option<std::time::Instant>,
+    stop: Option<&AtomicBool>,
+) -> Result<T, DriveError>
+where
+    B: Bus + ?Sized,
+    S: Service + ?Sized,
+{
+    loop {
+        while let Some(frame) = service.poll_transmit() {
+            bus.send(&frame).map_err(DriveError::Io)?;
+        }
+        while let Some(event) = service.poll_event() {
+            if let ControlFlow::Break(value) = until(event) {
+                return Ok(value);
+            }
+        }
+        if stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
+            return Err(DriveError::Stopped);
+        }
+        let now = std::time::Instant::now();
+        if deadline.is_some_and(|deadline| now >= deadline) {
+            return Err(DriveError::Deadline);
+        }
+        let timer = service.poll_timeout();
+        if let Some(at) = timer
+            && at <= clock.at(now)
+        {
+            service.handle_timeout(clock.at(now));
+            continue;
+        }
+        let mut wake = now + IDLE_WAIT;
+        for limit in [deadline, timer.map(|at| clock.to_std(at))]
+            .into_iter()
+            .flatten()
+        {
+            wake = wake.min(limit);
+        }
+        if stop.is_some() {
+            wake = wake.min(now + STOP_POLL);
+        }
+        if let Some(frame) = bus
+            .recv(wake.saturating_duration_since(now))
+            .map_err(DriveError::Io)?
+        {
+            service.handle_frame(clock.now(), &frame);
+        }
+    }
+}
+
+/// What an SDO driver call can fail with.
+#[derive(Debug)]
+pub enum Error {
+    /// The transfer failed: aborted by either side, or timed out.
+    Sdo(SdoError),
+    /// The value had the wrong length for its data type.
+    Value(od::ValueError),
+    /// The bus failed (the transfer was aborted locally).
+    Io(io::Error),
+    /// The client core refused to start a transfer.
+    Busy,
+    /// An uploaded VISIBLE_STRING holds `byte` at `offset`, outside the
+    /// visible characters 0x20 to 0x7E.
+    NotVisible {
+        /// Position in the uploaded data.
+        offset: usize,
+        /// The byte found there.
+        byte: u8,
+    },
+}
+
+impl fmt::Display for Error {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Error::Sdo(e) => e.fmt(f),
+            Error::Value(e) => write!(f, "bad value: {e}"),
+            Error::Io(e) => write!(f, "CAN bus error: {e}"),
+            Error::Busy => f.write_str("the SDO client is busy with another transfer"),
+            Error::NotVisible { offset, byte } => write!(
+                f,
+                "byte {byte:#04X} at offset {offset} is not a visible character (0x20 to 0x7E)"
+            ),
+        }
+    }
+}
+
+impl std::error::Error for Error {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            Error::Sdo(e) => Some(e),
+            Error::Io(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+impl From<SdoError> for Error {
+    fn from(e: SdoError) -> Error {
+        Error::Sdo(e)
+    }
+}
+
+impl From<od::ValueError> for Error {
+    fn from(e: od::ValueError) -> Error {
+        Error::Value(e)
+    }
+}
+
+impl From<io::Error> for Error {
+    fn from(e: io::Error) -> Error {
+        Error::Io(e)
+    }
+}
+
+/// The transfer a driver call runs.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Transfer<'a> {
+    Upload(Method),
+    Download(&'a [u8], Method),
+}
+
+impl Transfer<'_> {
+    /// Starts the transfer on the core.
+    pub(crate) fn start(
+        self,
+        core: &mut client::SdoClient,
+        now: Instant,
+        index: u16,
+        sub: u8,
+    ) -> Result<(), Error> {
+        // Events of earlier transfers (there are none unless a call was cut
+        // short) would make the core refuse.
+        while core.poll_event().is_some() {}
+        match self {
+            Transfer::Upload(method) => core.upload_with(now, index, sub, method),
+            Transfer::Download(data, method) => core.download_with(now, index, sub, data, method),
+        }
+        .map_err(|client::Busy| Error::Busy)
+    }
+
+    /// An upper bound of the transfer's duration when the server answers
+    /// every step just in time: one timeout per request/response step
+    /// (initiate, one per 7-byte segment, end) plus slack.
+    pub(crate) fn bound(self, config: &ClientConfig) -> Duration {
+        let len = match self {
+            Transfer::Upload(_) => config.max_upload,
+            Transfer::Download(data, _) => data.len(),
+        };
+        let steps = len.div_ceil(7).saturating_add(4);
+        let steps = u32::try_from(steps).unwrap_or(u32::MAX);
+        config.timeout.saturating_mul(steps)
+    }
+}
+
+/// The value `drive`'s closure breaks with once the transfer of (index,
+/// sub) ended: the uploaded data (empty for downloads) or the error.
+pub(crate) fn transfer_end(
+    event: ClientEvent,
+    index: u16,
+    sub: u8,
+) -> ControlFlow<Result<Vec<u8>, Error>> {
+    match event {
+        ClientEvent::Uploaded {
+            index: i,
+            sub: s,
+            data,
+        } if (i, s) == (index, sub) => ControlFlow::Break(Ok(data)),
+        ClientEvent::Downloaded { index: i, sub: s } if (i, s) == (index, sub) => {
+            ControlFlow::Break(Ok(Vec::new()))
+        }
+        ClientEvent::Failed {
+            index: i,
+            sub: s,
+            error,
+        } if (i, s) == (index, sub) => ControlFlow::Break(Err(Error::Sdo(error))),
+        _ => ControlFlow::Continue(()),
+    }
+}
+
+/// Ends a transfer the driver gives up on: aborts it on the core (the
+/// caller then sends the abort frame) and drops its events. Returns the
+/// error to report.
+pub(crate) fn give_up(core: &mut client::SdoClient, error: DriveError) -> Error {
+    let (code, error) = match error {
+        DriveError::Io(e) => (AbortCode::GeneralError, Error::Io(e)),
+        DriveError::Deadline | DriveError::Stopped => {
+            (AbortCode::Timeout, Error::Sdo(SdoError::Timeout))
+        }
+    };
+    if !core.is_idle() {
+        core.abort(code);
+    }
+    while core.poll_event().is_some() {}
+    error
+}
+
+/// A VISIBLE_STRING value: the bytes before the first NUL (CiA 301 allows
+/// NUL as padding), each a visible character 0x20 to 0x7E.
+pub(crate) fn visible_string(mut data: Vec<u8>) -> Result<String, Error> {
+    if let Some(end) = data.iter().position(|&b| b == 0) {
+        data.truncate(end);
+    }
+    if let Some(offset) = data.iter().position(|b| !(0x20..=0x7E).contains(b)) {
+        let byte = data.get(offset).copied().unwrap_or(0);
+        return Err(Error::NotVisible { offset, byte });
+    }
+    // Every byte is ASCII, so this never fails.
+    String::from_utf8(data).map_err(|e| Error::NotVisible {
+        offset: e.utf8_error().valid_up_to(),
+        byte: 0,
+    })
+}
+
+/// The bus form of a typed value: a buffer and its used length.
+pub(crate) fn encode<E>(value: E::Value) -> Result<([u8; 8], usize), Error>
+where
+    E: Entry,
+    E::Access: od::Write,
+    E::Value: od::Scalar,
+{
+    let mut buf = [0u8; 8];
+    let len = od::encode_value::<E>(value, &mut buf)?;
+    Ok((buf, len))
+}
+
+/// A blocking SDO client for one node: each call runs one whole transfer.
+///
+/// Every call ends: the core bounds each step by
+/// [`ClientConfig::timeout`], and the driver also gives up (aborting with
+/// 0x05040000) once the whole transfer took longer than one timeout per
+/// step it can have.
+#[derive(Debug)]
+pub struct SdoClient<B> {
+    bus: B,
+    clock: Clock,
+    core: client::SdoClient,
+}
+
+impl<B: Bus> SdoClient<B> {
+    /// A client on `bus` with `config` (its channel names the node).
+    pub fn new(bus: B, config: ClientConfig) -> SdoClient<B> {
+        SdoClient::with_clock(bus, config, Clock::new())
+    }
+
+    /// A client whose core sees time through `clock`.
+    pub fn with_clock(bus: B, config: ClientConfig, clock: Clock) -> SdoClient<B> {
+        SdoClient {
+            bus,
+            clock,
+            core: client::SdoClient::new(config),
+        }
+    }
+
+    /// The sans-IO core.
+    pub fn core(&self) -> &client::SdoClient {
+        &self.core
+    }
+
+    /// The bus.
+    pub fn bus(&self) -> &B {
+        &self.bus
+    }
+
+    /// The bus, to send or receive other frames between transfers.
+    pub fn bus_mut(&mut self) -> &mut B {
+        &mut self.bus
+    }
+
+    /// Gives the bus back.
+    pub fn into_bus(self) -> B {
+        self.bus
+    }
+
+    fn transfer(&mut self, index: u16, sub: u8, transfer: Transfer<'_>) -> Result<Vec<u8>, Error> {
+        transfer.start(&mut self.core, self.clock.now(), index, sub)?;
+        let deadline = deadline_after(transfer.bound(self.core.config()));
+        let until = |event| transfer_end(event, index, sub);
+        match drive(&mut self.bus, &self.clock, &mut self.core, until, deadline) {
+            Ok(result) => result,
+            Err(e) => {
+                let error = give_up(&mut self.core, e);
+                while let Some(frame) = self.core.poll_transmit() {
+                    // Best effort: the abort frame of a failing bus may not go.
+                    let _ = self.bus.send(&frame);
+                }
+                Err(error)
+            }
+        }
+    }
+
+    /// Reads (index, sub) with [`Method::Auto`].
+    pub fn upload(&mut self, index: u16, sub: u8) -> Result<Vec<u8>, Error> {
+        self.upload_with(index, sub, Method::Auto)
+    }
+
+    /// Reads (index, sub) with `method`.
+    pub fn upload_with(&mut self, index: u16, sub: u8, method: Method) -> Result<Vec<u8>, Error> {
+        self.transfer(index, sub, Transfer::Upload(method))
+    }
+
+    /// Writes `data` to (index, sub) with [`Method::Auto`].
+    pub fn download(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), Error> {
+        self.download_with(index, sub, data, Method::Auto)
+    }
+
+    /// Writes `data` to (index, sub) with `method`.
+    pub fn download_with(
+        &mut self,
+        index: u16,
+        sub: u8,
+        data: &[u8],
+        method: Method,
+    ) -> Result<(), Error> {
+        self.transfer(index, sub, Transfer::Download(data, method))
+            .map(drop)
+    }
+
+    /// Reads the value of entry `E`.
+    pub fn read<E>(&mut self) -> Result<E::Value, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::Scalar,
+    {
+        let data = self.upload(E::INDEX, E::SUBINDEX)?;
+        Ok(od::decode_value::<E>(&data)?)
+    }
+
+    /// Writes `value` to entry `E`.
+    pub fn write<E>(&mut self, value: E::Value) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::Scalar,
+    {
+        let (buf, len) = encode::<E>(value)?;
+        self.download(E::INDEX, E::SUBINDEX, buf.get(..len).unwrap_or(&buf))
+    }
+
+    /// Reads the bytes of a string, DOMAIN or other byte-valued entry.
+    pub fn read_bytes<E>(&mut self) -> Result<Vec<u8>, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::ByteValue,
+    {
+        self.upload(E::INDEX, E::SUBINDEX)
+    }
+
+    /// Reads a VISIBLE_STRING entry: the text before the first NUL; a byte
+    /// outside 0x20 to 0x7E gives [`Error::NotVisible`] (use
+    /// [`SdoClient::read_bytes`] for the raw bytes).
+    pub fn read_string<E>(&mut self) -> Result<String, Error>
+    where
+        E: Entry<Value = od::bytes::VisibleString>,
+        E::Access: od::Read,
+    {
+        visible_string(self.upload(E::INDEX, E::SUBINDEX)?)
+    }
+
+    /// Writes the bytes of a string, DOMAIN or other byte-valued entry.
+    pub fn write_bytes<E>(&mut self, data: &[u8]) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::ByteValue,
+    {
+        self.download(E::INDEX, E::SUBINDEX, data)
+    }
+}
+
+/// `now + after`, or a point far in the future when that overflows.
+pub(crate) fn deadline_after(after: Duration) -> std::time::Instant {
+    let now = std::time::Instant::now();
+    now.checked_add(after)
+        .or_else(|| now.checked_add(Duration::from_secs(30 * 365 * 24 * 3600)))
+        .unwrap_or(now)
+}
+
+#[cfg(test)]
+mod tests;

@@ -7,7 +7,13 @@
 //!   caller-supplied clock of the protocol cores.
 //! - Protocol cores, sans-IO (fed frames and the current time; they return
 //!   frames to send, events and their next deadline through [`Service`]):
-//!   [`sdo`] (client and server: expedited, segmented, block).
+//!   [`sdo`] (client and server: expedited, segmented, block), [`nmt`]
+//!   (master and slave), [`heartbeat`] (producer and consumer), [`guarding`]
+//!   (node guarding, both sides), [`emcy`] (consumer, error tables), [`sync`]
+//!   (producer and consumer).
+//! - With `std`: [`transport`] (the virtual bus, candump logs, fault
+//!   injection, SocketCAN, `embedded-can`) and the drivers [`blocking`] and,
+//!   with `tokio`, `tokio`.
 //!
 //! Features: `std` (default) and `alloc` (SDO buffers); `tokio`,
 //! `socketcan` (Linux) and `embedded-can` for the transports.

@@ -4,8 +4,8 @@
 //! implements [`Entry`]: its index, subindex, CiA 301 data type, value type and
 //! access right live in the type system. The functions here are generic over
 //! those types, so that the compiler rejects a write to a read-only object
-//! ([`encode_value`] needs [`Writable`]), a read of a write-only object
-//! ([`decode_value`] needs [`Readable`]), a value of the wrong type and a
+//! ([`encode_value`] needs [`Write`]), a read of a write-only object
+//! ([`decode_value`] needs [`Read`]), a value of the wrong type and a
 //! non-mappable object in a PDO mapping ([`mapping_entry`] needs
 //! [`PdoMappable`]). Everything here needs only `core`.
 

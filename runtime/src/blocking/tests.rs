@@ -1,0 +1,214 @@
+use std::sync::Arc;
+use std::vec;
+
+use super::*;
+use crate::transport::virtual_bus::VirtualBus;
+use crate::{CanId, Frame};
+
+/// A test core: sends `ping` once, reports every frame with id `listen`,
+/// and reports `Tick` every `period` (its timer).
+struct Pinger {
+    ping: Option<Frame>,
+    listen: u16,
+    period: Duration,
+    next_tick: Option<Instant>,
+    events: Vec<PingEvent>,
+}
+
+#[derive(Debug, PartialEq)]
+enum PingEvent {
+    Got(Frame),
+    Tick(Instant),
+}
+
+impl Pinger {
+    fn new(ping: Option<Frame>, listen: u16, period: Duration) -> Pinger {
+        Pinger {
+            ping,
+            listen,
+            period,
+            next_tick: Some(Instant::ZERO + period),
+            events: Vec::new(),
+        }
+    }
+}
+
+impl Service for Pinger {
+    type Event = PingEvent;
+    fn handle_frame(&mut self, _now: Instant, frame: &Frame) {
+        if frame.cob_id() == Some(self.listen) {
+            self.events.push(PingEvent::Got(*frame));
+        }
+    }
+    fn handle_timeout(&mut self, now: Instant) {
+        self.events.push(PingEvent::Tick(now));
+        self.next_tick = Some(now + self.period);
+    }
+    fn poll_transmit(&mut self) -> Option<Frame> {
+        self.ping.take()
+    }
+    fn poll_event(&mut self) -> Option<PingEvent> {
+        (!self.events.is_empty()).then(|| self.events.remove(0))
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        self.next_tick
+    }
+}
+
+fn frame(id: u16, data: &[u8]) -> Frame {
+    Frame::new(CanId::Standard(id), data).unwrap()
+}
+
+#[test]
+fn drive_sends_feeds_frames_and_stops_on_break() {
+    let bus = VirtualBus::new();
+    let mut port = bus.attach();
+    let peer = bus.attach();
+    peer.transmit(&frame(0x300, &[9]));
+    peer.transmit(&frame(0x200, &[1]));
+    let clock = Clock::new();
+    let mut core = Pinger::new(Some(frame(0x100, &[7])), 0x200, Duration::from_secs(60));
+    let got = drive(
+        &mut port,
+        &clock,
+        &mut core,
+        |event| match event {
+            PingEvent::Got(frame) => ControlFlow::Break(frame),
+            PingEvent::Tick(_) => ControlFlow::Continue(()),
+        },
+        deadline_after(Duration::from_secs(5)),
+    )
+    .unwrap();
+    assert_eq!(got, frame(0x200, &[1]));
+    // The core's frame went out.
+    assert_eq!(peer.try_recv(), Some(frame(0x100, &[7])));
+}
+
+#[test]
+fn drive_runs_timers_and_honours_the_deadline() {
+    let bus = VirtualBus::new();
+    let mut port = bus.attach();
+    let clock = Clock::new();
+    let mut core = Pinger::new(None, 0x200, Duration::from_millis(10));
+    let mut ticks = Vec::new();
+    let start = std::time::Instant::now();
+    let result = drive(
+        &mut port,
+        &clock,
+        &mut core,
+        |event| {
+            if let PingEvent::Tick(at) = event {
+                ticks.push(at);
+            }
+            ControlFlow::<()>::Continue(())
+        },
+        start + Duration::from_millis(60),
+    );
+    assert!(matches!(result, Err(DriveError::Deadline)));
+    assert!(start.elapsed() >= Duration::from_millis(60));
+    assert!((3..=6).contains(&ticks.len()), "{ticks:?}");
+    // Each tick came at or after its deadline.
+    let mut due = Instant::ZERO + Duration::from_millis(10);
+    for tick in ticks {
+        assert!(tick >= due);
+        due = tick + Duration::from_millis(10);
+    }
+}
+
+#[test]
+fn serve_stops_on_the_flag() {
+    let bus = VirtualBus::new();
+    let mut port = bus.attach();
+    let peer = bus.attach();
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let server = std::thread::spawn(move || {
+        let clock = Clock::new();
+        let mut core = Pinger::new(None, 0x200, Duration::from_secs(60));
+        let mut seen = Vec::new();
+        serve(&mut port, &clock, &mut core, &flag, None, |e| seen.push(e)).unwrap();
+        seen
+    });
+    peer.transmit(&frame(0x200, &[1]));
+    peer.transmit(&frame(0x201, &[2]));
+    peer.transmit(&frame(0x200, &[3]));
+    std::thread::sleep(Duration::from_millis(50));
+    stop.store(true, Ordering::Relaxed);
+    let seen = server.join().unwrap();
+    assert_eq!(
+        seen,
+        vec![
+            PingEvent::Got(frame(0x200, &[1])),
+            PingEvent::Got(frame(0x200, &[3]))
+        ]
+    );
+}
+
+#[test]
+fn serve_ends_at_its_deadline() {
+    let bus = VirtualBus::new();
+    let mut port = bus.attach();
+    let stop = AtomicBool::new(false);
+    let clock = Clock::new();
+    let mut core = Pinger::new(None, 0x200, Duration::from_secs(60));
+    let start = std::time::Instant::now();
+    let deadline = start + Duration::from_millis(30);
+    serve(&mut port, &clock, &mut core, &stop, Some(deadline), |_| {}).unwrap();
+    let took = start.elapsed();
+    assert!(took >= Duration::from_millis(30) && took < Duration::from_secs(2));
+}
+
+#[test]
+fn visible_strings() {
+    assert_eq!(visible_string(b"Drive 1".to_vec()).unwrap(), "Drive 1");
+    assert_eq!(visible_string(b"ab\0\0\xFF".to_vec()).unwrap(), "ab");
+    assert_eq!(visible_string(Vec::new()).unwrap(), "");
+    assert!(matches!(
+        visible_string(b"caf\xE9".to_vec()),
+        Err(Error::NotVisible {
+            offset: 3,
+            byte: 0xE9
+        })
+    ));
+    assert!(matches!(
+        visible_string(b"a\nb".to_vec()),
+        Err(Error::NotVisible {
+            offset: 1,
+            byte: b'\n'
+        })
+    ));
+}
+
+#[test]
+fn transfer_bound_counts_steps() {
+    let mut config = ClientConfig::new(crate::sdo::Channel {
+        request: 0x601,
+        response: 0x581,
+    });
+    config.timeout = Duration::from_millis(100);
+    config.max_upload = 70;
+    // 70 bytes: 10 segments + 4 = 14 steps.
+    assert_eq!(
+        Transfer::Upload(Method::Auto).bound(&config),
+        Duration::from_millis(1400)
+    );
+    assert_eq!(
+        Transfer::Download(&[0; 4], Method::Auto).bound(&config),
+        Duration::from_millis(500)
+    );
+}
+
+#[test]
+fn errors_display() {
+    let e = Error::Sdo(SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist));
+    assert!(e.to_string().contains("0x06020000"), "{e}");
+    assert_eq!(
+        Error::NotVisible {
+            offset: 2,
+            byte: 0x80
+        }
+        .to_string(),
+        "byte 0x80 at offset 2 is not a visible character (0x20 to 0x7E)"
+    );
+    assert_eq!(DriveError::Deadline.to_string(), "the deadline passed");
+}

@@ -1,0 +1,164 @@
+//! Expedited and segmented transfers (the standard SDO protocols of
+//! CiA 301), and the bounded upload buffer that block uploads share.
+
+use alloc::collections::TryReserveError;
+use alloc::vec::Vec;
+
+use super::{Ended, Phase, SEGMENT_BYTES, SdoClient};
+use crate::Instant;
+use crate::sdo::AbortCode;
+use crate::sdo::proto::{Initiate, Request};
+
+/// Smallest capacity the upload buffer grows to when the size is unknown.
+const MIN_GROWTH: usize = 64;
+
+impl SdoClient {
+    /// Checks a size the server announced against `max_upload` and reserves
+    /// it; fails the transfer with out of memory when it does not fit.
+    pub(super) fn reserve_announced(&mut self, size: Option<u32>) -> Result<Option<usize>, Ended> {
+        let Some(size) = size else {
+            return Ok(None);
+        };
+        match usize::try_from(size) {
+            Ok(size)
+                if size <= self.config.max_upload && self.buf.try_reserve_exact(size).is_ok() =>
+            {
+                Ok(Some(size))
+            }
+            _ => Err(self.fail(AbortCode::OutOfMemory)),
+        }
+    }
+
+    /// Appends upload data, bounded by the announced `size` (else by
+    /// `max_upload`); fails the transfer when it does not fit.
+    pub(super) fn append_upload(&mut self, bytes: &[u8], size: Option<usize>) -> Result<(), Ended> {
+        let limit = size.unwrap_or(self.config.max_upload);
+        if self.buf.len().saturating_add(bytes.len()) > limit {
+            return Err(self.fail(too_long_code(size)));
+        }
+        if reserve_bounded(&mut self.buf, bytes.len(), limit).is_err() {
+            return Err(self.fail(AbortCode::OutOfMemory));
+        }
+        self.buf.extend_from_slice(bytes);
+        Ok(())
+    }
+
+    /// Sends the download segment starting at byte `offset`.
+    pub(super) fn send_download_segment(&mut self, now: Instant, offset: usize, toggle: bool) {
+        let rest = self.buf.get(offset..).unwrap_or(&[]);
+        let mut data = [0u8; SEGMENT_BYTES];
+        let len = copy_prefix(&mut data, rest);
+        self.send(Request::DownloadSegment {
+            toggle,
+            last: rest.len() <= SEGMENT_BYTES,
+            data,
+            len: len as u8,
+        });
+        self.wait(
+            now,
+            Phase::DownloadSegment {
+                toggle,
+                sent: offset + len,
+            },
+        );
+    }
+
+    /// The server's answer to an upload initiate (also when it switched from
+    /// a block upload to the standard protocol).
+    pub(super) fn on_upload_initiate(
+        &mut self,
+        now: Instant,
+        index: u16,
+        sub: u8,
+        data: Initiate,
+    ) -> Result<(), Ended> {
+        if !self.is_ours(index, sub) {
+            return Err(self.fail(AbortCode::ParameterIncompatible));
+        }
+        match data {
+            Initiate::Expedited { data, len } => {
+                let bytes = data.get(..usize::from(len)).unwrap_or(&data);
+                self.append_upload(bytes, None)?;
+                Err(self.finish_upload())
+            }
+            Initiate::Segmented { size } => {
+                let size = self.reserve_announced(size)?;
+                self.send(Request::UploadSegment { toggle: false });
+                self.wait(
+                    now,
+                    Phase::UploadSegment {
+                        toggle: false,
+                        size,
+                    },
+                );
+                Ok(())
+            }
+        }
+    }
+
+    /// An upload segment with the expected toggle bit.
+    pub(super) fn on_upload_segment(
+        &mut self,
+        now: Instant,
+        toggle: bool,
+        size: Option<usize>,
+        bytes: &[u8],
+        last: bool,
+    ) -> Result<(), Ended> {
+        self.append_upload(bytes, size)?;
+        if !last {
+            self.send(Request::UploadSegment { toggle: !toggle });
+            self.wait(
+                now,
+                Phase::UploadSegment {
+                    toggle: !toggle,
+                    size,
+                },
+            );
+            return Ok(());
+        }
+        if size.is_some_and(|size| size != self.buf.len()) {
+            return Err(self.fail(AbortCode::LengthMismatch));
+        }
+        Err(self.finish_upload())
+    }
+}
+
+/// The abort code for upload data beyond the announced size, or beyond
+/// `max_upload` when no size was announced.
+pub(super) fn too_long_code(size: Option<usize>) -> AbortCode {
+    if size.is_some() {
+        AbortCode::LengthMismatch
+    } else {
+        AbortCode::OutOfMemory
+    }
+}
+
+/// Makes room for `additional` more bytes, growing geometrically but never
+/// beyond `limit` (`buf.len() + additional` must not exceed it).
+pub(super) fn reserve_bounded(
+    buf: &mut Vec<u8>,
+    additional: usize,
+    limit: usize,
+) -> Result<(), TryReserveError> {
+    let needed = buf.len().saturating_add(additional);
+    if needed <= buf.capacity() {
+        return Ok(());
+    }
+    let target = buf
+        .capacity()
+        .saturating_mul(2)
+        .max(MIN_GROWTH)
+        .min(limit)
+        .max(needed);
+    buf.try_reserve_exact(target - buf.len())
+}
+
+/// Copies as much of `src` as fits into `dst`; returns the bytes copied.
+pub(super) fn copy_prefix(dst: &mut [u8], src: &[u8]) -> usize {
+    let len = dst.len().min(src.len());
+    for (slot, byte) in dst.iter_mut().zip(src) {
+        *slot = *byte;
+    }
+    len
+}
