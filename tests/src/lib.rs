@@ -1,6 +1,8 @@
 //! Shared helpers of eds2rust's cross-crate tests: where the workspace, the
-//! shared corpus and the python-canopen oracle are.
+//! shared corpus and the python-canopen oracle are, and the python-canopen
+//! peer process of the interop tests ([`peer`]).
 
+pub mod peer;
 pub mod python;
 
 use std::path::{Path, PathBuf};

@@ -159,6 +159,20 @@ impl<S: ObjectStore> SdoServer<S> {
             };
             return self.remote_abort(code);
         }
+        // An empty value may come without any segment (python-canopen's
+        // client sends the end request right after the initiate): for an
+        // announced size of 0, an end request before the first segment ends
+        // the transfer.
+        if let State::BlockDownload(transfer) = &mut self.state
+            && transfer.size == Some(0)
+            && transfer.next_seq == 1
+            && !transfer.gap
+            && self.buf.is_empty()
+            && let Ok(Request::BlockDownloadEnd { crc, .. }) = Request::parse(data)
+        {
+            transfer.ended = true;
+            return self.block_download_end(0, crc);
+        }
         let segment = match BlockSegment::parse(data) {
             Ok(segment) => segment,
             Err(error) => return self.fail(segment_error(error)),
