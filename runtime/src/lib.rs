@@ -24,12 +24,15 @@ extern crate alloc;
 #[cfg(all(feature = "std", not(test)))]
 extern crate std;
 
+pub mod cia402;
 pub mod emcy;
 pub mod frame;
 pub mod guarding;
 pub mod heartbeat;
+pub mod lss;
 pub mod nmt;
 pub mod od;
+pub mod pdo;
 pub mod sdo;
 pub mod sync;
 pub mod time;
