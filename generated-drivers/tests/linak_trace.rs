@@ -46,6 +46,33 @@ fn cob_ids_of_node_32_are_the_traces() {
 }
 
 #[test]
+fn pdo_mappings_are_the_manuals() {
+    use eds2rust_runtime::od::Pdo;
+    // TPDO1: position u16, current u8, status flags u8, error code u8,
+    // speed u16, AUX inputs u8 (0x2001 sub 1..6), 8 bytes.
+    assert_eq!(
+        <pdo::Tpdo1Feedback as Pdo>::MAPPING,
+        &[
+            0x2001_0110,
+            0x2001_0208,
+            0x2001_0308,
+            0x2001_0408,
+            0x2001_0510,
+            0x2001_0608
+        ]
+    );
+    assert_eq!(
+        <pdo::Tpdo1Feedback as Pdo>::default_cob_id(node32()),
+        Some(0x1A0)
+    );
+    assert_eq!(<pdo::Rpdo1Command as Pdo>::MAPPING.len(), 7);
+    assert_eq!(
+        <pdo::Rpdo1Command as Pdo>::default_cob_id(node32()),
+        Some(0x220)
+    );
+}
+
+#[test]
 fn startup_frame_reports_power_up_lock() {
     // "1A0 00 00 00 81 01 00 00 C0": TPDO1 before the first Stop command.
     let fb = pdo::Tpdo1Feedback::decode(&[0x00, 0x00, 0x00, 0x81, 0x01, 0x00, 0x00, 0xC0]).unwrap();

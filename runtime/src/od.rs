@@ -454,6 +454,13 @@ pub trait Pdo: Sized {
     const MAPPING_INDEX: u16;
     /// Data length in bytes.
     const LEN: usize;
+    /// The mapping parameter's entries in order (`index << 16 | subindex <<
+    /// 8 | bits`), dummy entries included: what a PDO configuration writes
+    /// to sub 1.. of [`Pdo::MAPPING_INDEX`].
+    const MAPPING: &'static [u32];
+    /// The COB-ID entry's default for a node (sub 1 of
+    /// [`Pdo::COMMUNICATION_INDEX`]), when the source gives one.
+    fn default_cob_id(node_id: NodeId) -> Option<u32>;
     /// Decodes a frame's data; it must be exactly [`Pdo::LEN`] bytes.
     fn decode(data: &[u8]) -> Result<Self, PdoLengthError>;
     /// Encodes into the first [`Pdo::LEN`] bytes of `out`; returns that length.

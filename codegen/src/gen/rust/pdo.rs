@@ -34,6 +34,8 @@ struct Layout<'a> {
     number: u16,
     fields: Vec<Field<'a>>,
     gaps: Vec<(u32, u32, DataType)>,
+    /// The mapping entries in order, dummies included (`index << 16 | sub << 8 | bits`).
+    entries: Vec<u32>,
     total: u32,
 }
 
@@ -127,6 +129,7 @@ fn layout<'a>(
     );
     let mut fields = Vec::new();
     let mut gaps = Vec::new();
+    let mut entries = Vec::new();
     let mut offset = 0u32;
     for entry in mapping
         .entries
@@ -137,6 +140,7 @@ fn layout<'a>(
             continue;
         };
         let target = MappedObject::from_raw(raw);
+        entries.push(raw);
         let width = u32::from(target.bits);
         let problems = check_entry(device, raw);
         let fatal: Vec<&MappingProblem> = problems
@@ -236,6 +240,7 @@ fn layout<'a>(
             number,
             fields,
             gaps,
+            entries,
             total: offset,
         },
         fields_ns,
@@ -416,7 +421,10 @@ fn emit_struct(
     } else {
         quote!(#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)])
     };
-    let cob = cob_id_items(comm_default(1), rt);
+    let cob_default = comm_default(1);
+    let cob = cob_id_items(cob_default, rt);
+    let default_cob_id = default_cob_id_fn(cob_default, rt);
+    let mapping_lits = layout.entries.iter().map(|&e| prim::hex(u128::from(e)));
     let number = Literal::u16_unsuffixed(layout.number);
     let comm_lit = prim::hex(u128::from(comm_index));
     let map_lit = prim::hex(u128::from(layout.mapping.index));
@@ -454,6 +462,8 @@ fn emit_struct(
             const COMMUNICATION_INDEX: u16 = #comm_lit;
             const MAPPING_INDEX: u16 = #map_lit;
             const LEN: usize = #len_lit;
+            const MAPPING: &'static [u32] = &[#(#mapping_lits,)*];
+            #default_cob_id
             #[inline] fn decode(data: &[u8]) -> ::core::result::Result<Self, #rt::od::PdoLengthError> {
                 Self::decode(data)
             }
@@ -463,6 +473,30 @@ fn emit_struct(
                 }
                 #len_lit
             }
+        }
+    }
+}
+
+/// `od::Pdo::default_cob_id` from the communication parameter's default.
+fn default_cob_id_fn(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> TokenStream {
+    let value = default.and_then(|literal| match literal.value {
+        Value::Integer(v) => u32::try_from(v).ok().map(|v| (v, literal.plus_node_id)),
+        _ => None,
+    });
+    let body = match value {
+        Some((_, true)) => quote!(::core::option::Option::Some(Self::cob_id(node_id))),
+        Some((_, false)) => quote!({
+            let _ = node_id;
+            ::core::option::Option::Some(Self::COB_ID)
+        }),
+        None => quote!({
+            let _ = node_id;
+            ::core::option::Option::None
+        }),
+    };
+    quote! {
+        #[inline] fn default_cob_id(node_id: #rt::od::NodeId) -> ::core::option::Option<u32> {
+            #body
         }
     }
 }
