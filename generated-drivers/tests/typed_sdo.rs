@@ -105,3 +105,69 @@ fn generated_entries_read_and_write_through_the_sdo_client() {
     let store = server.join().unwrap();
     assert_eq!(store.get(0x2000, 1), Some(&[0x03, 0xFB][..]));
 }
+
+/// `od::OBJECTS` lists every entry as data: a store built from it alone (the
+/// start of a generic device simulator) answers typed reads with the
+/// source's defaults, `$NODEID` defaults resolved for the node.
+#[test]
+fn object_table_fills_an_sdo_store() {
+    use eds2rust_drivers::linak_techline::od::OBJECTS;
+    use eds2rust_runtime::od::DefaultValue;
+
+    assert!(
+        OBJECTS
+            .windows(2)
+            .all(|w| (w[0].index, w[0].subindex) < (w[1].index, w[1].subindex))
+    );
+    let position = OBJECTS
+        .iter()
+        .find(|o| (o.index, o.subindex) == (0x2001, 1))
+        .expect("feedback position is listed");
+    assert_eq!(position.access, AccessRight::Ro);
+    assert_eq!(
+        position.data_type,
+        eds2rust_runtime::od::DataType::Unsigned16
+    );
+    assert!(position.pdo_mappable);
+
+    let node = NodeId::new(32).unwrap();
+    let mut store = MemoryStore::new();
+    for object in OBJECTS {
+        let mut buf = [0u8; 8];
+        if let Some(len) = object.encode_default(Some(node), &mut buf) {
+            store.insert(object.index, object.subindex, object.access, &buf[..len]);
+        } else if let Some(DefaultValue::Bytes(bytes)) = object.default {
+            store.insert(object.index, object.subindex, object.access, bytes);
+        }
+    }
+    let bus = VirtualBus::new();
+    let stop = Arc::new(AtomicBool::new(false));
+    let mut server = SdoServer::new(ServerConfig::new(Channel::default_for(node)), store);
+    let mut port = bus.attach();
+    let stop_server = stop.clone();
+    let handle = thread::spawn(move || {
+        blocking::serve(
+            &mut port,
+            &Clock::new(),
+            &mut server,
+            &stop_server,
+            None,
+            |_| {},
+        )
+        .unwrap();
+    });
+    let mut client = SdoClient::new(bus.attach(), ClientConfig::new(Channel::default_for(node)));
+    assert_eq!(client.read::<od::CobIdEmcy>().unwrap(), 0xA0);
+    assert_eq!(
+        client
+            .read::<od::sdo_server_parameter::CobIdClientToServer>()
+            .unwrap(),
+        od::sdo_server_parameter::CobIdClientToServer::default_for(node)
+    );
+    assert_eq!(
+        client.read::<od::ProducerHeartbeatTime>().unwrap(),
+        od::ProducerHeartbeatTime::DEFAULT
+    );
+    stop.store(true, Ordering::Relaxed);
+    handle.join().unwrap();
+}

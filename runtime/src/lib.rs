@@ -10,7 +10,9 @@
 //!   [`sdo`] (client and server: expedited, segmented, block), [`nmt`]
 //!   (master and slave), [`heartbeat`] (producer and consumer), [`guarding`]
 //!   (node guarding, both sides), [`emcy`] (consumer, error tables), [`sync`]
-//!   (producer and consumer).
+//!   (producer and consumer), [`pdo`] (RPDO transmitter, TPDO receiver,
+//!   mapping configuration over SDO), [`lss`] (CiA 305 master and slave),
+//!   [`cia402`] (drive helper and device state machine).
 //! - With `std`: [`transport`] (the virtual bus, candump logs, fault
 //!   injection, SocketCAN, `embedded-can`) and the drivers [`blocking`] and,
 //!   with `tokio`, `tokio`.

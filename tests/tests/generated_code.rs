@@ -450,8 +450,13 @@ fn collect_tokens(
             TokenTree::Ident(ident) => idents.push(ident.to_string()),
             TokenTree::Literal(literal) => {
                 let range = literal.span().byte_range();
-                if let syn::Lit::Str(s) = syn::Lit::new(literal) {
-                    literals.push((range, s.value()));
+                match syn::Lit::new(literal) {
+                    syn::Lit::Str(s) => literals.push((range, s.value())),
+                    // String defaults of `od::OBJECTS` are byte strings.
+                    syn::Lit::ByteStr(s) => {
+                        literals.push((range, String::from_utf8_lossy(&s.value()).into_owned()))
+                    }
+                    _ => {}
                 }
             }
             TokenTree::Punct(_) => {}

@@ -409,7 +409,7 @@ fn access_tokens(rt: &TokenStream, access: Access) -> TokenStream {
     }
 }
 
-fn data_type_tokens(rt: &TokenStream, data_type: DataType) -> TokenStream {
+pub(super) fn data_type_tokens(rt: &TokenStream, data_type: DataType) -> TokenStream {
     use DataType::*;
     let variant = match data_type {
         Boolean => quote!(Boolean),

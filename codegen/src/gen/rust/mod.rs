@@ -21,6 +21,7 @@ mod entries;
 mod enums;
 mod errors;
 mod naming;
+mod objects;
 mod pdo;
 mod prim;
 mod scaled;
@@ -94,6 +95,7 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
     let (od_items, infos) = entries::emit(&mut cx);
     let error_items = errors::emit(device, &error_plans, &rt, &mut diags);
     let pdo_items = pdo::emit(device, &infos, &rt, &mut diags);
+    let object_table = objects::emit(device, &rt);
     let identity = identity_items(device);
 
     let mut file = identity;
@@ -101,6 +103,7 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
         #[doc = " The object dictionary: one zero-sized type per entry (see the runtime's `od::Entry`)."]
         pub mod od {
             #od_items
+            #object_table
         }
     });
     if !device.error_tables.is_empty() {

@@ -1,0 +1,189 @@
+//! Configuring a PDO over a blocking SDO client (`std`):
+//! [`configure_pdo`] runs the steps of a [`PdoConfig`].
+
+use core::fmt;
+use std::vec::Vec;
+
+use super::config::{Step, StepAction, read_value};
+use super::{ConfigCheckError, PdoConfig};
+use crate::blocking::{Error, SdoClient};
+use crate::sdo::{AbortCode, SdoError};
+use crate::transport::Bus;
+
+/// Why [`configure_pdo`] failed.
+#[derive(Debug)]
+pub enum PdoConfigError {
+    /// The configuration breaks a CiA 301 rule; nothing was sent.
+    Invalid(ConfigCheckError),
+    /// An SDO access failed (refused by the device, timed out, bus error).
+    Transfer {
+        /// The step that failed.
+        step: Step,
+        /// Its 1-based position in the plan.
+        number: usize,
+        /// Number of steps in the plan.
+        total: usize,
+        /// The SDO error.
+        error: Error,
+    },
+    /// A value read back differs from the one written: the device accepted
+    /// the write but did not keep the value.
+    Mismatch {
+        /// The read-back step.
+        step: Step,
+        /// Its 1-based position in the plan.
+        number: usize,
+        /// Number of steps in the plan.
+        total: usize,
+        /// The bytes read back.
+        read: Vec<u8>,
+    },
+}
+
+impl PdoConfigError {
+    /// The step that failed (`None` for an invalid configuration).
+    pub fn step(&self) -> Option<&Step> {
+        match self {
+            PdoConfigError::Invalid(_) => None,
+            PdoConfigError::Transfer { step, .. } | PdoConfigError::Mismatch { step, .. } => {
+                Some(step)
+            }
+        }
+    }
+
+    /// The abort code that ended a failed SDO access.
+    pub fn abort_code(&self) -> Option<AbortCode> {
+        match self {
+            PdoConfigError::Transfer {
+                error: Error::Sdo(e),
+                ..
+            } => Some(e.code()),
+            _ => None,
+        }
+    }
+
+    /// Whether the PDO was left disabled (COB-ID bit 31 set): a write
+    /// after the first one (which disables it) failed before the last one
+    /// (which enables it again).
+    pub fn pdo_left_disabled(&self) -> bool {
+        match self {
+            PdoConfigError::Transfer { step, number, .. } => {
+                step.action() == StepAction::Write && *number > 1
+            }
+            _ => false,
+        }
+    }
+}
+
+impl fmt::Display for PdoConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            PdoConfigError::Invalid(e) => {
+                write!(f, "invalid PDO configuration, nothing was sent: {e}")
+            }
+            PdoConfigError::Transfer {
+                step,
+                number,
+                total,
+                error,
+            } => {
+                write!(
+                    f,
+                    "PDO configuration step {number} of {total} failed: {step}: "
+                )?;
+                match error {
+                    Error::Sdo(SdoError::RemoteAbort(code)) => {
+                        write!(f, "the device refused: {code}")?
+                    }
+                    Error::Sdo(SdoError::Timeout) => {
+                        f.write_str("the device did not answer in time")?
+                    }
+                    Error::Sdo(SdoError::LocalAbort(code)) => {
+                        write!(f, "the SDO client aborted the transfer: {code}")?
+                    }
+                    other => other.fmt(f)?,
+                }
+                if self.pdo_left_disabled() {
+                    f.write_str("; the PDO is left disabled")?;
+                }
+                Ok(())
+            }
+            PdoConfigError::Mismatch {
+                step,
+                number,
+                total,
+                read,
+            } => {
+                write!(
+                    f,
+                    "PDO configuration step {number} of {total} failed: read back {} (object {:#06X} sub {}): wrote {}, read ",
+                    step.name(),
+                    step.index(),
+                    step.sub(),
+                    step.format_value(step.value().into())
+                )?;
+                match read_value(read) {
+                    Some(value) => write!(f, "{}", step.format_value(value))?,
+                    None => write!(f, "{} bytes {read:02X?}", read.len())?,
+                }
+                f.write_str("; the device did not keep the value")
+            }
+        }
+    }
+}
+
+impl std::error::Error for PdoConfigError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            PdoConfigError::Invalid(e) => Some(e),
+            PdoConfigError::Transfer { error, .. } => Some(error),
+            PdoConfigError::Mismatch { .. } => None,
+        }
+    }
+}
+
+impl From<ConfigCheckError> for PdoConfigError {
+    fn from(e: ConfigCheckError) -> Self {
+        PdoConfigError::Invalid(e)
+    }
+}
+
+/// Configures a PDO of the client's node: checks `config`
+/// ([`PdoConfig::check`]), then runs its steps in order (the writes in the
+/// CiA 301 order, then the read-backs) and stops at the first failure.
+///
+/// When a write after the first one fails, the PDO stays disabled (its
+/// COB-ID keeps bit 31 set); [`PdoConfigError::pdo_left_disabled`] tells.
+pub fn configure_pdo<B: Bus>(
+    client: &mut SdoClient<B>,
+    config: &PdoConfig<'_>,
+) -> Result<(), PdoConfigError> {
+    config.check()?;
+    let total = config.step_count();
+    for (i, step) in config.steps().enumerate() {
+        let number = i + 1;
+        let fail = |error| PdoConfigError::Transfer {
+            step,
+            number,
+            total,
+            error,
+        };
+        match step.action() {
+            StepAction::Write => client
+                .download(step.index(), step.sub(), step.bytes())
+                .map_err(fail)?,
+            StepAction::ReadBack => {
+                let read = client.upload(step.index(), step.sub()).map_err(fail)?;
+                if !step.matches(&read) {
+                    return Err(PdoConfigError::Mismatch {
+                        step,
+                        number,
+                        total,
+                        read,
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
+}
