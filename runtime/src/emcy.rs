@@ -8,8 +8,8 @@
 use core::fmt;
 
 use crate::frame::cob;
-use crate::nmt::queue::Ring;
 use crate::od::{ErrorTable, NodeId};
+use crate::queue::Ring;
 use crate::{Frame, Instant, Service};
 
 /// One emergency message.

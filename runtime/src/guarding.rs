@@ -13,8 +13,8 @@ use core::time::Duration;
 use crate::frame::{CanId, cob};
 use crate::heartbeat::{next_period, parse_error_control};
 use crate::nmt::NmtState;
-use crate::nmt::queue::Ring;
 use crate::od::NodeId;
+use crate::queue::Ring;
 use crate::{Frame, Instant, Service};
 
 /// The guarding request for `node`: a remote frame on 0x700 + node, DLC 1.

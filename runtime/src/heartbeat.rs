@@ -9,8 +9,8 @@ use core::time::Duration;
 
 use crate::frame::cob;
 use crate::nmt::NmtState;
-use crate::nmt::queue::Ring;
 use crate::od::NodeId;
+use crate::queue::Ring;
 use crate::{Frame, Instant, Service};
 
 /// The heartbeat frame of `node` in `state`: 0x700 + node, data `[state]`.

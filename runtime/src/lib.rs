@@ -35,6 +35,7 @@ pub mod lss;
 pub mod nmt;
 pub mod od;
 pub mod pdo;
+mod queue;
 pub mod sdo;
 pub mod sync;
 pub mod time;

@@ -12,7 +12,7 @@ use crate::heartbeat::parse_error_control;
 use crate::od::NodeId;
 use crate::{Frame, Instant, Service};
 
-use self::queue::Ring;
+use crate::queue::Ring;
 
 /// An NMT module-control command (byte 0 of a frame on COB-ID 0x000).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -305,7 +305,6 @@ impl Service for NmtMaster {
     }
 }
 
-pub(crate) mod queue;
 mod slave;
 
 pub use slave::{NmtSlave, NmtSlaveEvent};

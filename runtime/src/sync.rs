@@ -11,7 +11,7 @@ use core::time::Duration;
 
 use crate::frame::cob;
 use crate::heartbeat::next_period;
-use crate::nmt::queue::Ring;
+use crate::queue::Ring;
 use crate::{Frame, Instant, Service};
 
 /// The default SYNC COB-ID.

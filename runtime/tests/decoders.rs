@@ -74,6 +74,19 @@ proptest! {
     }
 
     #[test]
+    fn lss_frames(data in prop_oneof![
+        proptest::collection::vec(any::<u8>(), 8),
+        input(),
+    ]) {
+        fuzz_checks::lss_frames(&data);
+    }
+
+    #[test]
+    fn pdo_receiver(data in input()) {
+        fuzz_checks::pdo_receiver(&data);
+    }
+
+    #[test]
     fn candump_line(text in "(\\([0-9]{1,10}\\.[0-9]{0,9}\\) )?([a-z0-9]{1,6} )?[0-9A-Fa-f]{3,8}#(R[0-9]?|[0-9A-Fa-f.]{0,20})") {
         fuzz_checks::candump_line(text.as_bytes());
     }

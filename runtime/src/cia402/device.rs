@@ -39,7 +39,7 @@ use core::time::Duration;
 
 use super::words::{Controlword, ModeOfOperation, State, Statusword};
 use crate::Instant;
-use crate::nmt::queue::Ring;
+use crate::queue::Ring;
 
 /// How the simulated device behaves.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -4,7 +4,7 @@ use super::object;
 use super::types::{DriveConfig, DriveError, Event, Move, Step, Write, WriteValue};
 use super::words::{Command, Controlword, ModeOfOperation, State, Statusword};
 use crate::Instant;
-use crate::nmt::queue::Ring;
+use crate::queue::Ring;
 use crate::time::earliest;
 
 mod plan;

@@ -8,8 +8,8 @@ use crate::lss::proto::{RangeField, Request, Response};
 use crate::lss::{
     BitTiming, ERROR_NONE, Identity, IdentityField, IdentityRange, LssState, node_id_byte,
 };
-use crate::nmt::queue::Ring;
 use crate::od::NodeId;
+use crate::queue::Ring;
 use crate::{Frame, Instant, Service};
 
 /// The response timeout of a new [`LssMaster`]. CiA 305 leaves it to the

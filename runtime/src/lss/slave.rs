@@ -5,8 +5,8 @@ use crate::lss::{
     BitRate, BitTiming, ERROR_NONE, ERROR_NOT_SUPPORTED, Identity, IdentityField, LssState,
     node_id_byte,
 };
-use crate::nmt::queue::Ring;
 use crate::od::NodeId;
+use crate::queue::Ring;
 use crate::{Frame, Instant, Service};
 
 /// What an [`LssSlave`] tells the device (or simulator) around it.

@@ -1,8 +1,8 @@
 //! The NMT slave state machine of one node (CiA 301).
 
-use super::queue::Ring;
 use super::{NmtCommand, NmtState, parse_command};
 use crate::od::NodeId;
+use crate::queue::Ring;
 use crate::{Frame, Instant, Service};
 
 /// What an [`NmtSlave`] did.

@@ -4,8 +4,8 @@ use core::fmt;
 use core::time::Duration;
 
 use super::{CobId, CobIdError};
-use crate::nmt::queue::Ring;
 use crate::od::{self, PdoLengthError};
+use crate::queue::Ring;
 use crate::time::earliest;
 use crate::{Frame, Instant, Service};
 

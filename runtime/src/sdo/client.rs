@@ -31,7 +31,6 @@
 //! [`SdoError::RemoteAbort`] and nothing is sent.
 
 mod block;
-mod queue;
 mod segmented;
 #[cfg(test)]
 mod tests;
@@ -45,8 +44,11 @@ use super::proto::{BlockSegment, Initiate, Request, Response};
 use super::{AbortCode, Channel, DEFAULT_TIMEOUT, MAX_BLOCK_SIZE, SdoError};
 use crate::{Frame, Instant, Service};
 
+use crate::queue::Ring;
 use block::{DownloadBlock, UploadBlock};
-use queue::TxQueue;
+
+/// Frames the client holds for `poll_transmit`.
+const TX_SLOTS: usize = 4;
 
 /// Data bytes in one segment (segmented and block transfers).
 const SEGMENT_BYTES: usize = 7;
@@ -196,7 +198,10 @@ pub struct SdoClient {
     /// Download data, or upload data received so far. Its capacity stays
     /// within `max_upload` between transfers.
     buf: Vec<u8>,
-    tx: TxQueue,
+    /// Frames built and not yet taken by `poll_transmit`; a caller that
+    /// drains after every input never has more than two waiting. When full
+    /// (the caller stopped draining) the oldest is dropped.
+    tx: Ring<[u8; 8], TX_SLOTS>,
     events: VecDeque<ClientEvent>,
 }
 
@@ -210,7 +215,7 @@ impl SdoClient {
             sub: 0,
             deadline: Instant::ZERO,
             buf: Vec::new(),
-            tx: TxQueue::new(),
+            tx: Ring::new(),
             events: VecDeque::new(),
         }
     }

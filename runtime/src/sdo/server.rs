@@ -35,7 +35,6 @@ use crate::{Frame, Instant, Service};
 
 mod block;
 mod memory;
-mod queue;
 mod segmented;
 #[cfg(test)]
 mod tests;
@@ -44,8 +43,8 @@ mod tests_block;
 
 pub use memory::{MemoryStore, StoredValue};
 
+use crate::queue::Ring;
 use block::{BlockDownload, BlockUpload};
-use queue::Ring;
 
 /// The object dictionary behind an SDO server.
 pub trait ObjectStore {

@@ -1,21 +1,21 @@
-//! A fixed-capacity FIFO queue without heap, shared by the small protocol
-//! cores (NMT, heartbeat, guarding, EMCY, SYNC) for their events and frames.
+//! A fixed-capacity FIFO queue without heap, shared by the protocol cores
+//! for the frames and events they hand out.
 
 /// FIFO of at most `N` values. [`Ring::push`] drops the oldest value when
 /// full and counts it; [`Ring::try_push`] refuses instead.
 #[derive(Debug, Clone)]
-pub(crate) struct Ring<T: Copy, const N: usize> {
+pub(crate) struct Ring<T, const N: usize> {
     slots: [Option<T>; N],
     head: usize,
     len: usize,
     dropped: u32,
 }
 
-impl<T: Copy, const N: usize> Ring<T, N> {
+impl<T, const N: usize> Ring<T, N> {
     /// An empty queue.
     pub(crate) const fn new() -> Self {
         Ring {
-            slots: [None; N],
+            slots: [const { None }; N],
             head: 0,
             len: 0,
             dropped: 0,
@@ -27,8 +27,12 @@ impl<T: Copy, const N: usize> Ring<T, N> {
         if self.len >= N {
             return Err(value);
         }
-        let tail = (self.head + self.len).checked_rem(N).ok_or(value)?;
-        let slot = self.slots.get_mut(tail).ok_or(value)?;
+        let Some(slot) = (self.head + self.len)
+            .checked_rem(N)
+            .and_then(|tail| self.slots.get_mut(tail))
+        else {
+            return Err(value);
+        };
         *slot = Some(value);
         self.len += 1;
         Ok(())
