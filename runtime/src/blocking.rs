@@ -21,6 +21,9 @@ use crate::sdo::{AbortCode, SdoError};
 use crate::transport::{Bus, Clock};
 use crate::{Instant, Service};
 
+mod master;
+pub use master::{LssRequestError, MASTER_QUEUE_CAPACITY, Master};
+
 /// How often [`serve`] looks at its stop flag while nothing happens.
 pub const STOP_POLL: Duration = Duration::from_millis(10);
 

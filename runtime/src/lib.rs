@@ -32,6 +32,8 @@ pub mod frame;
 pub mod guarding;
 pub mod heartbeat;
 pub mod lss;
+#[cfg(feature = "alloc")]
+pub mod master;
 pub mod nmt;
 pub mod od;
 pub mod pdo;

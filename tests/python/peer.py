@@ -328,6 +328,59 @@ class Peer:
 
     # Plumbing ------------------------------------------------------------
 
+    # PDOs of a RemoteNode with an object dictionary -----------------------
+
+    def op_remote_node_eds(self, cmd):
+        """Replaces RemoteNode `node` by one whose object dictionary is the
+        EDS file `eds` (needed to name and decode PDO variables)."""
+        node = cmd["node"]
+        with self.lock:
+            old = self.remote.pop(node, None)
+            if old is not None:
+                self.network.nodes.pop(node, None)
+            remote = canopen.RemoteNode(node, cmd["eds"])
+            heard = self.heard.setdefault(node, [])
+
+            def on_heartbeat(state, heard=heard):
+                if len(heard) < HEARD_KEPT:
+                    heard.append(state)
+            remote.nmt.add_heartbeat_callback(on_heartbeat)
+            self.network.add_node(remote)
+            self.remote[node] = remote
+        return {}
+
+    def op_tpdo_read(self, cmd):
+        """Reads every TPDO's configuration over SDO (PdoMap.read with
+        from_od=False), which also subscribes to the PDOs."""
+        remote = self.remote_node(cmd["node"])
+        remote.sdo.RESPONSE_TIMEOUT = cmd.get("timeout", 1.0)
+        remote.tpdo.read(from_od=False)
+        maps = []
+        for number, pdo_map in sorted(remote.tpdo.map.items()):
+            maps.append({
+                "number": number,
+                "cob_id": pdo_map.cob_id,
+                "enabled": pdo_map.enabled,
+                "trans_type": pdo_map.trans_type,
+                "event_timer": pdo_map.event_timer,
+                "inhibit_time": pdo_map.inhibit_time,
+                "map": [[v.index, v.subindex, v.length] for v in pdo_map.map],
+            })
+        return {"maps": maps}
+
+    def op_tpdo_wait(self, cmd):
+        """Waits for the next reception of TPDO `number` and returns its data
+        and every variable's decoded raw value."""
+        pdo_map = self.remote_node(cmd["node"]).tpdo.map[cmd["number"]]
+        pdo_map.wait_for_reception(timeout=cmd.get("timeout", 2.0))
+        if not pdo_map.is_received:
+            raise ValueError("TPDO %d of node %d was not received" %
+                             (cmd["number"], cmd["node"]))
+        with pdo_map.receive_condition:
+            data = bytes(pdo_map.data)
+            values = [[v.index, v.subindex, v.raw] for v in pdo_map.map]
+        return {"data": data.hex().upper(), "values": values}
+
     def run_command(self, cmd):
         reply = {"id": cmd.get("id")}
         try:

@@ -158,6 +158,31 @@ pub fn configure_pdo<B: Bus>(
     client: &mut SdoClient<B>,
     config: &PdoConfig<'_>,
 ) -> Result<(), PdoConfigError> {
+    run_steps(client, config)
+}
+
+/// One node's objects, read and written over SDO by a blocking driver.
+pub(crate) trait SdoAccess {
+    /// Writes `data` to (index, sub).
+    fn download(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), Error>;
+    /// Reads (index, sub).
+    fn upload(&mut self, index: u16, sub: u8) -> Result<Vec<u8>, Error>;
+}
+
+impl<B: Bus> SdoAccess for SdoClient<B> {
+    fn download(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), Error> {
+        SdoClient::download(self, index, sub, data)
+    }
+    fn upload(&mut self, index: u16, sub: u8) -> Result<Vec<u8>, Error> {
+        SdoClient::upload(self, index, sub)
+    }
+}
+
+/// The body of [`configure_pdo`], over any blocking SDO access.
+pub(crate) fn run_steps(
+    client: &mut impl SdoAccess,
+    config: &PdoConfig<'_>,
+) -> Result<(), PdoConfigError> {
     config.check()?;
     let total = config.step_count();
     for (i, step) in config.steps().enumerate() {

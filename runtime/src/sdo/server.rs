@@ -198,6 +198,16 @@ impl<S: ObjectStore> SdoServer<S> {
         self.store
     }
 
+    /// Moves the server to `channel` (the node id changed, for example by
+    /// LSS and reset communication). A running transfer is dropped without
+    /// an answer, as the node it belonged to is gone.
+    pub fn set_channel(&mut self, channel: Channel) {
+        self.config.channel = channel;
+        self.state = State::Idle;
+        self.deadline = None;
+        self.buf.clear();
+    }
+
     /// No transfer running.
     pub fn is_idle(&self) -> bool {
         matches!(self.state, State::Idle)

@@ -1,0 +1,635 @@
+//! The blocking driver of the composite [`crate::master::Master`].
+
+use core::fmt;
+use core::ops::ControlFlow;
+use core::time::Duration;
+use std::collections::VecDeque;
+use std::collections::vec_deque;
+use std::io;
+use std::string::String;
+use std::vec::Vec;
+
+use super::{
+    DriveError, Error, IDLE_WAIT, Transfer, deadline_after, encode, give_up, transfer_end,
+    visible_string,
+};
+use crate::lss::{
+    ConfigureService, Identity, IdentityField, KnownIdentity, LssError, LssEvent, LssMaster,
+    LssState,
+};
+use crate::master::{self, MasterEvent};
+use crate::nmt::NmtCommand;
+use crate::od::{self, Entry, NodeId};
+use crate::pdo::PdoConfig;
+use crate::pdo::blocking::{PdoConfigError, SdoAccess, run_steps};
+use crate::sdo::client::Method;
+use crate::transport::{Bus, Clock};
+use crate::{Instant, Service};
+
+/// Events [`Master`] keeps for [`Master::next_event`] by default.
+pub const MASTER_QUEUE_CAPACITY: usize = 1024;
+
+/// Timeouts an LSS request may take: fastscan waits out up to 133, plus
+/// slack.
+const LSS_STEPS: u32 = 140;
+
+/// Why an LSS call of [`Master`] failed.
+#[derive(Debug)]
+pub enum LssRequestError {
+    /// Another LSS request is still in progress.
+    Busy,
+    /// The bus failed (the request was cancelled).
+    Io(io::Error),
+    /// No slave answered within the LSS timeout.
+    NoResponse,
+    /// The slave answered a configuration service with an error.
+    Refused {
+        /// The service it refused.
+        service: ConfigureService,
+        /// The error code (1: not supported, 2: storage access, 0xFF:
+        /// implementation-specific, see `spec`).
+        error: u8,
+        /// The implementation-specific error.
+        spec: u8,
+    },
+    /// The request ended with an event that does not answer it.
+    Unexpected(LssEvent),
+}
+
+impl fmt::Display for LssRequestError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LssRequestError::Busy => f.write_str(
+                "an LSS request is already in progress; wait for its event before the next",
+            ),
+            LssRequestError::Io(e) => write!(f, "CAN bus error: {e}"),
+            LssRequestError::NoResponse => f.write_str("no LSS slave answered in time"),
+            LssRequestError::Refused {
+                service,
+                error,
+                spec,
+            } => {
+                let service = match service {
+                    ConfigureService::NodeId => "configure node id",
+                    ConfigureService::BitTiming => "configure bit timing",
+                    ConfigureService::Store => "store configuration",
+                };
+                write!(
+                    f,
+                    "the LSS slave refused {service}: error {error}, implementation-specific error {spec}"
+                )
+            }
+            LssRequestError::Unexpected(e) => write!(f, "unexpected end of the LSS request: {e:?}"),
+        }
+    }
+}
+
+impl std::error::Error for LssRequestError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            LssRequestError::Io(e) => Some(e),
+            _ => None,
+        }
+    }
+}
+
+/// A composite CANopen master on a bus, driven on the calling thread.
+///
+/// Every blocking call (an SDO transfer, an LSS request, [`Master::run_for`],
+/// [`Master::run_until`]) runs all the cores while it waits: the master's
+/// heartbeat and SYNC go out on time, PDOs are sent and received, NMT,
+/// heartbeat and EMCY frames are taken in. Events that the call does not
+/// wait for are queued (at most [`Master::set_queue_capacity`], oldest
+/// dropped first and counted) for [`Master::next_event`] and
+/// [`Master::drain_events`]. Between calls nothing runs: an application
+/// with nothing to do calls [`Master::run_for`] or [`Master::run_until`].
+///
+/// ```
+/// use core::time::Duration;
+/// use eds2rust_runtime::blocking::Master;
+/// use eds2rust_runtime::master;
+/// use eds2rust_runtime::nmt::NmtCommand;
+/// use eds2rust_runtime::od::NodeId;
+/// use eds2rust_runtime::transport::virtual_bus::VirtualBus;
+///
+/// let bus = VirtualBus::new();
+/// let monitor = bus.attach();
+/// let core = master::Master::new(NodeId::new(1).unwrap(), Duration::from_millis(100));
+/// let mut m = Master::new(bus.attach(), core);
+/// m.start()?; // boot-up message of node 1
+/// m.nmt(NmtCommand::Start, NodeId::new(0x20))?;
+/// m.run_for(Duration::from_millis(150))?; // one heartbeat
+/// let seen: Vec<String> = std::iter::from_fn(|| monitor.try_recv())
+///     .map(|f| f.to_string())
+///     .collect();
+/// assert_eq!(seen, ["701#00", "000#0120", "701#7F"]);
+/// // Typed SDO calls: m.read::<SomeEntry>(node)?, m.write::<SomeEntry>(node, value)?
+/// # Ok::<(), std::io::Error>(())
+/// ```
+#[derive(Debug)]
+pub struct Master<B> {
+    bus: B,
+    clock: Clock,
+    core: master::Master,
+    queue: VecDeque<MasterEvent>,
+    capacity: usize,
+    dropped: u64,
+}
+
+impl<B: Bus> Master<B> {
+    /// Drives `core` on `bus`, with a clock starting now.
+    pub fn new(bus: B, core: master::Master) -> Master<B> {
+        Master::with_clock(bus, core, Clock::new())
+    }
+
+    /// Drives `core` on `bus`; the core sees time through `clock`.
+    pub fn with_clock(bus: B, core: master::Master, clock: Clock) -> Master<B> {
+        Master {
+            bus,
+            clock,
+            core,
+            queue: VecDeque::new(),
+            capacity: MASTER_QUEUE_CAPACITY,
+            dropped: 0,
+        }
+    }
+
+    /// The sans-IO core.
+    pub fn core(&self) -> &master::Master {
+        &self.core
+    }
+
+    /// The sans-IO core, to configure its cores (PDOs, heartbeat consumer,
+    /// SDO clients) or to start requests without waiting for them.
+    pub fn core_mut(&mut self) -> &mut master::Master {
+        &mut self.core
+    }
+
+    /// The bus.
+    pub fn bus(&self) -> &B {
+        &self.bus
+    }
+
+    /// The bus, to send other frames.
+    pub fn bus_mut(&mut self) -> &mut B {
+        &mut self.bus
+    }
+
+    /// The clock of the cores.
+    pub fn clock(&self) -> &Clock {
+        &self.clock
+    }
+
+    /// The current time of the cores.
+    pub fn now(&self) -> Instant {
+        self.clock.now()
+    }
+
+    /// Gives the bus and the core back (queued events are dropped).
+    pub fn into_parts(self) -> (B, master::Master) {
+        (self.bus, self.core)
+    }
+
+    /// Starts the core ([`master::Master::start`]) and sends its boot-up
+    /// message.
+    pub fn start(&mut self) -> io::Result<()> {
+        let now = self.now();
+        self.core.start(now);
+        self.flush()
+    }
+
+    /// Sends every frame the cores have ready.
+    pub fn flush(&mut self) -> io::Result<()> {
+        while let Some(frame) = self.core.poll_transmit() {
+            self.bus.send(&frame)?;
+        }
+        Ok(())
+    }
+
+    /// Takes in the frames already received and the timers already due,
+    /// without waiting, and sends what the cores have ready.
+    pub fn poll(&mut self) -> io::Result<()> {
+        loop {
+            let now = self.clock.now();
+            if self.core.poll_timeout().is_some_and(|at| at <= now) {
+                self.core.handle_timeout(now);
+            }
+            self.flush()?;
+            self.pump();
+            match self.bus.recv(Duration::ZERO)? {
+                Some(frame) => self.core.handle_frame(self.clock.now(), &frame),
+                None => return Ok(()),
+            }
+        }
+    }
+
+    /// Runs all cores for `duration`, queueing their events.
+    pub fn run_for(&mut self, duration: Duration) -> io::Result<()> {
+        let deadline = deadline_after(duration);
+        match self.wait(deadline, &mut Err::<(), _>) {
+            Ok(()) | Err(DriveError::Deadline | DriveError::Stopped) => Ok(()),
+            Err(DriveError::Io(e)) => Err(e),
+        }
+    }
+
+    /// Runs all cores until `until` breaks on an event or `deadline`
+    /// passes ([`DriveError::Deadline`]). Queued events are offered first,
+    /// oldest first. The event `until` breaks on is removed; the others
+    /// stay queued.
+    pub fn run_until<T>(
+        &mut self,
+        deadline: std::time::Instant,
+        mut until: impl FnMut(&MasterEvent) -> ControlFlow<T>,
+    ) -> Result<T, DriveError> {
+        for i in 0..self.queue.len() {
+            let Some(event) = self.queue.get(i) else {
+                break;
+            };
+            if let ControlFlow::Break(value) = until(event) {
+                self.queue.remove(i);
+                return Ok(value);
+            }
+        }
+        self.wait(deadline, &mut |event| match until(&event) {
+            ControlFlow::Break(value) => Ok(value),
+            ControlFlow::Continue(()) => Err(event),
+        })
+    }
+
+    /// The oldest queued event, or the next one within `timeout`
+    /// (`Ok(None)` when none came).
+    pub fn wait_event(&mut self, timeout: Duration) -> io::Result<Option<MasterEvent>> {
+        if let Some(event) = self.queue.pop_front() {
+            return Ok(Some(event));
+        }
+        match self.wait(deadline_after(timeout), &mut Ok) {
+            Ok(event) => Ok(Some(event)),
+            Err(DriveError::Io(e)) => Err(e),
+            Err(DriveError::Deadline | DriveError::Stopped) => Ok(None),
+        }
+    }
+
+    /// The oldest queued event (taken in by earlier calls; see
+    /// [`Master::poll`] to take in new frames without waiting).
+    pub fn next_event(&mut self) -> Option<MasterEvent> {
+        self.queue.pop_front()
+    }
+
+    /// All queued events, oldest first.
+    pub fn drain_events(&mut self) -> vec_deque::Drain<'_, MasterEvent> {
+        self.queue.drain(..)
+    }
+
+    /// Number of queued events.
+    pub fn queued_events(&self) -> usize {
+        self.queue.len()
+    }
+
+    /// Sets how many events the queue keeps (default
+    /// [`MASTER_QUEUE_CAPACITY`]); the oldest beyond that are dropped.
+    pub fn set_queue_capacity(&mut self, capacity: usize) {
+        self.capacity = capacity;
+        while self.queue.len() > capacity {
+            self.queue.pop_front();
+            self.dropped = self.dropped.saturating_add(1);
+        }
+    }
+
+    /// Events dropped because the queue was full.
+    pub fn dropped_events(&self) -> u64 {
+        self.dropped
+    }
+
+    fn push(&mut self, event: MasterEvent) {
+        if self.queue.len() >= self.capacity {
+            self.dropped = self.dropped.saturating_add(1);
+            if self.queue.pop_front().is_none() {
+                return;
+            }
+        }
+        self.queue.push_back(event);
+    }
+
+    /// Moves the cores' events into the queue.
+    fn pump(&mut self) {
+        while let Some(event) = self.core.poll_event() {
+            self.push(event);
+        }
+    }
+
+    /// The loop behind every call: runs the cores, handing each event to
+    /// `until`, which takes it (`Ok`, the call is done) or gives it back
+    /// to be queued (`Err`).
+    fn wait<T>(
+        &mut self,
+        deadline: std::time::Instant,
+        until: &mut dyn FnMut(MasterEvent) -> Result<T, MasterEvent>,
+    ) -> Result<T, DriveError> {
+        loop {
+            self.flush().map_err(DriveError::Io)?;
+            while let Some(event) = self.core.poll_event() {
+                match until(event) {
+                    Ok(value) => {
+                        // Best effort: a bus error shows again on the next call.
+                        let _ = self.flush();
+                        self.pump();
+                        return Ok(value);
+                    }
+                    Err(event) => self.push(event),
+                }
+            }
+            let now = std::time::Instant::now();
+            if now >= deadline {
+                return Err(DriveError::Deadline);
+            }
+            let timer = self.core.poll_timeout();
+            if let Some(at) = timer
+                && at <= self.clock.at(now)
+            {
+                self.core.handle_timeout(self.clock.at(now));
+                continue;
+            }
+            let mut wake = deadline.min(now + IDLE_WAIT);
+            if let Some(at) = timer {
+                wake = wake.min(self.clock.to_std(at));
+            }
+            if let Some(frame) = self
+                .bus
+                .recv(wake.saturating_duration_since(now))
+                .map_err(DriveError::Io)?
+            {
+                self.core.handle_frame(self.clock.now(), &frame);
+            }
+        }
+    }
+
+    /// Sends NMT `cmd` to `target` (`None`: all nodes).
+    pub fn nmt(&mut self, cmd: NmtCommand, target: Option<NodeId>) -> io::Result<()> {
+        if self.core.nmt.send(cmd, target).is_err() {
+            self.flush()?;
+            self.core.nmt.send(cmd, target).map_err(io::Error::other)?;
+        }
+        self.flush()
+    }
+
+    fn transfer(
+        &mut self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        transfer: Transfer<'_>,
+    ) -> Result<Vec<u8>, Error> {
+        // Events of transfers started on the core stay queued.
+        self.pump();
+        let now = self.now();
+        let client = self.core.sdo_or_default(node);
+        transfer.start(client, now, index, sub)?;
+        let deadline = deadline_after(transfer.bound(client.config()));
+        let result = self.wait(deadline, &mut |event| match event {
+            MasterEvent::Sdo(n, e) if n == node => match transfer_end(e.clone(), index, sub) {
+                ControlFlow::Break(result) => Ok(result),
+                ControlFlow::Continue(()) => Err(MasterEvent::Sdo(n, e)),
+            },
+            other => Err(other),
+        });
+        match result {
+            Ok(result) => result,
+            Err(e) => {
+                let error = give_up(self.core.sdo_or_default(node), e);
+                // Best effort: the abort frame of a failing bus may not go.
+                let _ = self.flush();
+                Err(error)
+            }
+        }
+    }
+
+    /// Reads (index, sub) of `node` with [`Method::Auto`]. A node without
+    /// an SDO client gets one on its default channel.
+    pub fn upload(&mut self, node: NodeId, index: u16, sub: u8) -> Result<Vec<u8>, Error> {
+        self.upload_with(node, index, sub, Method::Auto)
+    }
+
+    /// Reads (index, sub) of `node` with `method`.
+    pub fn upload_with(
+        &mut self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        method: Method,
+    ) -> Result<Vec<u8>, Error> {
+        self.transfer(node, index, sub, Transfer::Upload(method))
+    }
+
+    /// Writes `data` to (index, sub) of `node` with [`Method::Auto`].
+    pub fn download(
+        &mut self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        data: &[u8],
+    ) -> Result<(), Error> {
+        self.download_with(node, index, sub, data, Method::Auto)
+    }
+
+    /// Writes `data` to (index, sub) of `node` with `method`.
+    pub fn download_with(
+        &mut self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        data: &[u8],
+        method: Method,
+    ) -> Result<(), Error> {
+        self.transfer(node, index, sub, Transfer::Download(data, method))
+            .map(drop)
+    }
+
+    /// Reads entry `E` of `node`.
+    pub fn read<E>(&mut self, node: NodeId) -> Result<E::Value, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::Scalar,
+    {
+        let data = self.upload(node, E::INDEX, E::SUBINDEX)?;
+        Ok(od::decode_value::<E>(&data)?)
+    }
+
+    /// Writes `value` to entry `E` of `node`.
+    pub fn write<E>(&mut self, node: NodeId, value: E::Value) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::Scalar,
+    {
+        let (buf, len) = encode::<E>(value)?;
+        self.download(node, E::INDEX, E::SUBINDEX, buf.get(..len).unwrap_or(&buf))
+    }
+
+    /// Reads the bytes of a string, DOMAIN or other byte-valued entry.
+    pub fn read_bytes<E>(&mut self, node: NodeId) -> Result<Vec<u8>, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::ByteValue,
+    {
+        self.upload(node, E::INDEX, E::SUBINDEX)
+    }
+
+    /// Reads a VISIBLE_STRING entry: the text before the first NUL.
+    pub fn read_string<E>(&mut self, node: NodeId) -> Result<String, Error>
+    where
+        E: Entry<Value = od::bytes::VisibleString>,
+        E::Access: od::Read,
+    {
+        visible_string(self.upload(node, E::INDEX, E::SUBINDEX)?)
+    }
+
+    /// Writes the bytes of a string, DOMAIN or other byte-valued entry.
+    pub fn write_bytes<E>(&mut self, node: NodeId, data: &[u8]) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::ByteValue,
+    {
+        self.download(node, E::INDEX, E::SUBINDEX, data)
+    }
+
+    /// Configures a PDO of `node` as [`crate::pdo::blocking::configure_pdo`]
+    /// does (same steps, read-backs and errors).
+    pub fn configure_pdo(
+        &mut self,
+        node: NodeId,
+        config: &PdoConfig<'_>,
+    ) -> Result<(), PdoConfigError> {
+        run_steps(&mut NodeSdo { master: self, node }, config)
+    }
+
+    /// Starts an LSS request with `start` (given the LSS core and the
+    /// current time) and waits for the event that ends it.
+    pub fn lss(
+        &mut self,
+        start: impl FnOnce(&mut LssMaster, Instant) -> Result<(), LssError>,
+    ) -> Result<LssEvent, LssRequestError> {
+        self.pump();
+        let now = self.now();
+        start(&mut self.core.lss, now).map_err(|LssError| LssRequestError::Busy)?;
+        let bound = self
+            .core
+            .lss
+            .timeout()
+            .saturating_mul(LSS_STEPS)
+            .saturating_add(Duration::from_secs(1));
+        let result = self.wait(deadline_after(bound), &mut |event| match event {
+            MasterEvent::Lss(e) => Ok(e),
+            other => Err(other),
+        });
+        result.map_err(|e| {
+            self.core.lss.cancel();
+            match e {
+                DriveError::Io(e) => LssRequestError::Io(e),
+                DriveError::Deadline | DriveError::Stopped => LssRequestError::NoResponse,
+            }
+        })
+    }
+
+    /// Switch state global: every LSS slave enters `state`.
+    pub fn lss_switch_global(&mut self, state: LssState) -> Result<(), LssRequestError> {
+        let r = self.lss(|lss, now| lss.switch_global(now, state));
+        lss_outcome(r, |e| (e == LssEvent::Sent).then_some(()))
+    }
+
+    /// Switch state selective: the slave with `identity` enters the
+    /// configuration state.
+    pub fn lss_switch_selective(&mut self, identity: Identity) -> Result<(), LssRequestError> {
+        let r = self.lss(|lss, now| lss.switch_selective(now, identity));
+        lss_outcome(r, |e| (e == LssEvent::Selected).then_some(()))
+    }
+
+    /// Configures the node id of the slave in the configuration state
+    /// (`None`: unconfigured); it takes effect at its next NMT reset
+    /// communication.
+    pub fn lss_configure_node_id(&mut self, node: Option<NodeId>) -> Result<(), LssRequestError> {
+        let r = self.lss(|lss, now| lss.configure_node_id(now, node));
+        lss_outcome(r, |e| (e == LssEvent::NodeIdConfigured).then_some(()))
+    }
+
+    /// Makes the slave in the configuration state store its configuration.
+    pub fn lss_store(&mut self) -> Result<(), LssRequestError> {
+        let r = self.lss(|lss, now| lss.store_configuration(now));
+        lss_outcome(r, |e| (e == LssEvent::Stored).then_some(()))
+    }
+
+    /// Inquires one part of the address of the slave in the configuration
+    /// state.
+    pub fn lss_inquire_identity(&mut self, field: IdentityField) -> Result<u32, LssRequestError> {
+        let r = self.lss(|lss, now| lss.inquire_identity(now, field));
+        lss_outcome(r, |e| match e {
+            LssEvent::Identity { field: f, value } if f == field => Some(value),
+            _ => None,
+        })
+    }
+
+    /// Inquires the active node id of the slave in the configuration state
+    /// (0xFF: none).
+    pub fn lss_inquire_node_id(&mut self) -> Result<u8, LssRequestError> {
+        let r = self.lss(|lss, now| lss.inquire_node_id(now));
+        lss_outcome(r, |e| match e {
+            LssEvent::NodeId(id) => Some(id),
+            _ => None,
+        })
+    }
+
+    /// Fastscan: the address of one non-configured slave, now in the
+    /// configuration state; `None` when there is none.
+    pub fn lss_fastscan(
+        &mut self,
+        known: KnownIdentity,
+    ) -> Result<Option<Identity>, LssRequestError> {
+        let r = self.lss(|lss, now| lss.fastscan(now, known));
+        lss_outcome(r, |e| match e {
+            LssEvent::Found(identity) => Some(Some(identity)),
+            LssEvent::NotFound => Some(None),
+            _ => None,
+        })
+    }
+}
+
+/// The value of an LSS request's end event, or the error it stands for.
+fn lss_outcome<T>(
+    result: Result<LssEvent, LssRequestError>,
+    value: impl FnOnce(LssEvent) -> Option<T>,
+) -> Result<T, LssRequestError> {
+    let event = result?;
+    if let Some(v) = value(event) {
+        return Ok(v);
+    }
+    Err(match event {
+        LssEvent::NoResponse => LssRequestError::NoResponse,
+        LssEvent::ConfigureFailed {
+            service,
+            error,
+            spec,
+        } => LssRequestError::Refused {
+            service,
+            error,
+            spec,
+        },
+        other => LssRequestError::Unexpected(other),
+    })
+}
+
+/// One node's objects through a [`Master`], for the PDO configuration.
+struct NodeSdo<'a, B> {
+    master: &'a mut Master<B>,
+    node: NodeId,
+}
+
+impl<B: Bus> SdoAccess for NodeSdo<'_, B> {
+    fn download(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), Error> {
+        self.master.download(self.node, index, sub, data)
+    }
+    fn upload(&mut self, index: u16, sub: u8) -> Result<Vec<u8>, Error> {
+        self.master.upload(self.node, index, sub)
+    }
+}

@@ -1,0 +1,427 @@
+//! The blocking composite master over the virtual bus, against a device
+//! made of the runtime's SDO server, NMT slave and heartbeat producer
+//! (node 0x20) served in a thread, with a monitor port recording every
+//! frame and when it was seen.
+
+use std::ops::ControlFlow;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
+use std::thread;
+use std::time::{Duration, Instant as StdInstant};
+
+use eds2rust_runtime::blocking::{self, Error, Master};
+use eds2rust_runtime::emcy::EmcyEvent;
+use eds2rust_runtime::heartbeat::{HeartbeatEvent, HeartbeatProducer};
+use eds2rust_runtime::lss::LssState;
+use eds2rust_runtime::master::{self, MasterEvent};
+use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtSlave, NmtState};
+use eds2rust_runtime::od::{AccessRight, DataType, Entry, NodeId, PdoDirection, access};
+use eds2rust_runtime::pdo::{PdoConfig, PdoEvent};
+use eds2rust_runtime::sdo::server::{MemoryStore, ObjectStore, SdoServer, ServerConfig};
+use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};
+use eds2rust_runtime::transport::Clock;
+use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
+use eds2rust_runtime::{CanId, Frame, Instant, Service};
+
+const DEVICE: u8 = 0x20;
+/// The master's heartbeat period.
+const PERIOD: Duration = Duration::from_millis(20);
+/// How long the device takes to read its slow object.
+const SLOW: Duration = Duration::from_millis(300);
+
+fn node(id: u8) -> NodeId {
+    NodeId::new(id).unwrap()
+}
+
+struct ProducerHeartbeatTime;
+impl Entry for ProducerHeartbeatTime {
+    const INDEX: u16 = 0x1017;
+    const SUBINDEX: u8 = 0;
+    const NAME: &'static str = "Producer heartbeat time";
+    const DATA_TYPE: DataType = DataType::Unsigned16;
+    const PDO_MAPPABLE: bool = false;
+    type Access = access::Rw;
+    type Value = u16;
+}
+
+struct SlowValue;
+impl Entry for SlowValue {
+    const INDEX: u16 = 0x2000;
+    const SUBINDEX: u8 = 1;
+    const NAME: &'static str = "Slow value";
+    const DATA_TYPE: DataType = DataType::Unsigned32;
+    const PDO_MAPPABLE: bool = false;
+    type Access = access::Ro;
+    type Value = u32;
+}
+
+/// A memory store whose object 0x2000:01 takes [`SLOW`] to read.
+struct SlowStore(MemoryStore);
+
+impl ObjectStore for SlowStore {
+    fn read(&mut self, index: u16, sub: u8, out: &mut Vec<u8>) -> Result<(), AbortCode> {
+        if (index, sub) == (0x2000, 1) {
+            thread::sleep(SLOW);
+        }
+        self.0.read(index, sub, out)
+    }
+    fn check_write(&mut self, index: u16, sub: u8, size: Option<usize>) -> Result<(), AbortCode> {
+        self.0.check_write(index, sub, size)
+    }
+    fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), AbortCode> {
+        self.0.write(index, sub, data)
+    }
+}
+
+/// The device: SDO server, NMT slave, and a heartbeat that reports the NMT
+/// state every 50 ms.
+struct Device {
+    sdo: SdoServer<SlowStore>,
+    nmt: NmtSlave,
+    heartbeat: HeartbeatProducer,
+}
+
+impl Service for Device {
+    type Event = ();
+    fn handle_frame(&mut self, now: Instant, frame: &Frame) {
+        self.sdo.handle_frame(now, frame);
+        self.nmt.handle_frame(now, frame);
+        while self.nmt.poll_event().is_some() {}
+        self.heartbeat.set_state(self.nmt.state());
+    }
+    fn handle_timeout(&mut self, now: Instant) {
+        if self.sdo.poll_timeout().is_some_and(|at| at <= now) {
+            self.sdo.handle_timeout(now);
+        }
+        if self.heartbeat.poll_timeout().is_some_and(|at| at <= now) {
+            self.heartbeat.handle_timeout(now);
+        }
+    }
+    fn poll_transmit(&mut self) -> Option<Frame> {
+        self.sdo
+            .poll_transmit()
+            .or_else(|| self.heartbeat.poll_transmit())
+    }
+    fn poll_event(&mut self) -> Option<()> {
+        while self.sdo.poll_event().is_some() {}
+        None
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        eds2rust_runtime::time::earliest(self.sdo.poll_timeout(), self.heartbeat.poll_timeout())
+    }
+}
+
+/// The bus, the master on it, and the device and monitor threads.
+struct Rig {
+    bus: VirtualBus,
+    master: Master<VirtualPort>,
+    frames: Arc<Mutex<Vec<(StdInstant, Frame)>>>,
+    stop: Arc<AtomicBool>,
+    threads: Vec<thread::JoinHandle<()>>,
+}
+
+impl Rig {
+    fn new() -> Rig {
+        let bus = VirtualBus::new();
+        let stop = Arc::new(AtomicBool::new(false));
+        let frames = Arc::new(Mutex::new(Vec::new()));
+        let mut threads = Vec::new();
+
+        let monitor = bus.attach();
+        let (record, halt) = (frames.clone(), stop.clone());
+        threads.push(thread::spawn(move || {
+            while !halt.load(Ordering::Relaxed) {
+                if let Some(frame) = monitor.recv_timeout(Duration::from_millis(5)) {
+                    record.lock().unwrap().push((StdInstant::now(), frame));
+                }
+            }
+        }));
+
+        let mut port = bus.attach();
+        let halt = stop.clone();
+        threads.push(thread::spawn(move || {
+            let mut store = MemoryStore::new();
+            store.insert_fixed(0x1017, 0, AccessRight::Rw, &50u16.to_le_bytes());
+            store.insert_fixed(0x2000, 1, AccessRight::Ro, &0xCAFE_F00Du32.to_le_bytes());
+            for sub in [1, 2] {
+                store.insert_fixed(0x1800, sub, AccessRight::Rw, &[0; 4][..sub_len(sub)]);
+            }
+            store.insert_fixed(0x1A00, 0, AccessRight::Rw, &[0]);
+            store.insert_fixed(0x1A00, 1, AccessRight::Rw, &[0; 4]);
+            let id = node(DEVICE);
+            let mut device = Device {
+                sdo: SdoServer::new(
+                    ServerConfig::new(Channel::default_for(id)),
+                    SlowStore(store),
+                ),
+                nmt: NmtSlave::new(id),
+                heartbeat: HeartbeatProducer::new(id, Duration::from_millis(50)),
+            };
+            let clock = Clock::new();
+            device.nmt.boot_complete();
+            device.heartbeat.set_state(device.nmt.state());
+            device.heartbeat.start(clock.now());
+            blocking::serve(&mut port, &clock, &mut device, &halt, None, |()| {}).unwrap();
+        }));
+
+        let mut core = master::Master::new(node(1), PERIOD);
+        core.consumer
+            .monitor(node(DEVICE), Duration::from_millis(200));
+        let mut master = Master::new(bus.attach(), core);
+        master.start().unwrap();
+        Rig {
+            bus,
+            master,
+            frames,
+            stop,
+            threads,
+        }
+    }
+
+    /// The frames seen so far with `cob_id`, with when they were seen.
+    fn seen(&self, cob_id: u16) -> Vec<(StdInstant, Frame)> {
+        let frames = self.frames.lock().unwrap();
+        frames
+            .iter()
+            .filter(|(_, f)| f.cob_id() == Some(cob_id))
+            .copied()
+            .collect()
+    }
+}
+
+impl Drop for Rig {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+        for t in self.threads.drain(..) {
+            let _ = t.join();
+        }
+    }
+}
+
+/// Sub 1 (COB-ID) of 0x1800 has 4 bytes, sub 2 (transmission type) one.
+fn sub_len(sub: u8) -> usize {
+    if sub == 2 { 1 } else { 4 }
+}
+
+fn frame(id: u16, data: &[u8]) -> Frame {
+    Frame::new(CanId::Standard(id), data).unwrap()
+}
+
+#[test]
+fn heartbeat_keeps_its_period_during_a_slow_sdo_read() {
+    let mut rig = Rig::new();
+    let start = StdInstant::now();
+    assert_eq!(
+        rig.master.read::<SlowValue>(node(DEVICE)).unwrap(),
+        0xCAFE_F00D
+    );
+    let end = StdInstant::now();
+    assert!(end - start >= SLOW);
+
+    let beats: Vec<_> = rig.seen(0x701);
+    // Boot-up first, then heartbeats reporting Pre-operational (0x7F).
+    assert_eq!(beats[0].1, frame(0x701, &[0x00]));
+    let during: Vec<_> = beats
+        .iter()
+        .filter(|(at, _)| *at > start && *at <= end)
+        .collect();
+    assert!(
+        during.len() >= 12,
+        "{} heartbeats in {:?}",
+        during.len(),
+        end - start
+    );
+    for pair in during.windows(2) {
+        assert_eq!(pair[1].1, frame(0x701, &[0x7F]));
+        let gap = pair[1].0 - pair[0].0;
+        assert!(gap <= PERIOD + Duration::from_millis(15), "gap {gap:?}");
+    }
+
+    // Typed write and read back of 0x1017 (expedited, 2 bytes).
+    rig.master
+        .write::<ProducerHeartbeatTime>(node(DEVICE), 250)
+        .unwrap();
+    assert_eq!(
+        rig.master
+            .read::<ProducerHeartbeatTime>(node(DEVICE))
+            .unwrap(),
+        250
+    );
+    // A missing object: the device's abort 0x06020000 comes back.
+    let e = rig.master.upload(node(DEVICE), 0x2001, 0).unwrap_err();
+    assert!(matches!(
+        e,
+        Error::Sdo(SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist))
+    ));
+}
+
+#[test]
+fn nmt_command_bytes_and_the_state_the_node_reports() {
+    let mut rig = Rig::new();
+    rig.master
+        .nmt(NmtCommand::Start, Some(node(DEVICE)))
+        .unwrap();
+    let deadline = StdInstant::now() + Duration::from_secs(1);
+    let to = rig
+        .master
+        .run_until(deadline, |event| match event {
+            MasterEvent::Nmt(NmtEvent::StateChanged { node: n, to, .. })
+                if n.get() == DEVICE && *to == NmtState::Operational =>
+            {
+                ControlFlow::Break(*to)
+            }
+            _ => ControlFlow::Continue(()),
+        })
+        .unwrap();
+    assert_eq!(to, NmtState::Operational);
+    // CiA 301 NMT start remote node: command 0x01, node 0x20.
+    let nmt = rig.seen(0x000);
+    assert_eq!(nmt.len(), 1);
+    assert_eq!(nmt[0].1.to_string(), "000#0120");
+    assert_eq!(
+        rig.master.core().nmt.state(node(DEVICE)),
+        Some(NmtState::Operational)
+    );
+    assert!(rig.seen(0x720).iter().any(|(_, f)| f.data() == [0x05]));
+}
+
+#[test]
+fn a_pdo_received_during_an_sdo_transfer_is_kept_and_queued() {
+    let mut rig = Rig::new();
+    rig.master.core_mut().pdo_rx.watch(0x1A0, 2, None).unwrap();
+    // Another node sends its TPDO1 (0x1A0) while the slow read runs.
+    let sender = rig.bus.attach();
+    let pdo = thread::spawn(move || {
+        thread::sleep(Duration::from_millis(100));
+        sender.transmit(&frame(0x1A0, &[0x11, 0x22]));
+        sender.transmit(&frame(0x721, &[0x00]));
+        // EMCY 0x8110 (CAN overrun), error register 0x11.
+        sender.transmit(&frame(0x0A1, &[0x10, 0x81, 0x11, 0, 0, 0, 0, 0]));
+    });
+    assert_eq!(
+        rig.master.read::<SlowValue>(node(DEVICE)).unwrap(),
+        0xCAFE_F00D
+    );
+    pdo.join().unwrap();
+    assert_eq!(
+        rig.master.core().pdo_rx.latest_data(0x1A0),
+        Some(&[0x11, 0x22][..])
+    );
+    // Queued events are offered first, even with a deadline already past;
+    // the one taken leaves the queue.
+    let queued = rig.master.queued_events();
+    let data = rig
+        .master
+        .run_until(StdInstant::now(), |e| match e {
+            MasterEvent::Pdo(PdoEvent::Received {
+                cob_id: 0x1A0,
+                data,
+                ..
+            }) => ControlFlow::Break(*data),
+            _ => ControlFlow::Continue(()),
+        })
+        .unwrap();
+    assert_eq!(data[..2], [0x11, 0x22]);
+    assert_eq!(rig.master.queued_events(), queued - 1);
+    let events: Vec<_> = rig.master.drain_events().collect();
+    // The boot-up and the EMCY of node 0x21 came during the read too;
+    // neither event was lost.
+    assert!(
+        events.contains(&MasterEvent::Nmt(NmtEvent::BootUp(node(0x21)))),
+        "{events:?}"
+    );
+    assert!(
+        events
+            .iter()
+            .any(|e| matches!(e, MasterEvent::Emcy(EmcyEvent::Emergency { node: n, .. }) if n.get() == 0x21)),
+        "{events:?}"
+    );
+    assert_eq!(rig.master.dropped_events(), 0);
+    assert_eq!(rig.master.next_event(), None);
+}
+
+#[test]
+fn queue_capacity_bounds_the_events_and_counts_the_dropped() {
+    let mut rig = Rig::new();
+    // Wait for the device's boot-up so that it does not mix in.
+    let deadline = StdInstant::now() + Duration::from_secs(1);
+    rig.master
+        .run_until(deadline, |e| match e {
+            MasterEvent::Heartbeat(HeartbeatEvent::State {
+                state: NmtState::BootUp,
+                ..
+            }) => ControlFlow::Break(()),
+            _ => ControlFlow::Continue(()),
+        })
+        .unwrap();
+    rig.master.drain_events().for_each(drop);
+    rig.master.set_queue_capacity(2);
+    let sender = rig.bus.attach();
+    rig.master.core_mut().pdo_rx.watch(0x1A0, 1, None).unwrap();
+    for b in 1..=5 {
+        sender.transmit(&frame(0x1A0, &[b]));
+    }
+    rig.master.run_for(Duration::from_millis(30)).unwrap();
+    assert_eq!(rig.master.queued_events(), 2);
+    let got: Vec<_> = rig.master.drain_events().collect();
+    // The newest events stay; the three oldest were dropped and counted.
+    let pdo = |b| {
+        MasterEvent::Pdo(PdoEvent::Received {
+            cob_id: 0x1A0,
+            data: [b, 0, 0, 0, 0, 0, 0, 0],
+            len: 1,
+            at: Instant::ZERO,
+        })
+    };
+    let got: Vec<_> = got
+        .into_iter()
+        .map(|e| match e {
+            MasterEvent::Pdo(PdoEvent::Received {
+                cob_id, data, len, ..
+            }) => MasterEvent::Pdo(PdoEvent::Received {
+                cob_id,
+                data,
+                len,
+                at: Instant::ZERO,
+            }),
+            other => other,
+        })
+        .collect();
+    assert_eq!(got, [pdo(4), pdo(5)]);
+    assert_eq!(rig.master.dropped_events(), 3);
+}
+
+#[test]
+fn lss_switch_global_frame() {
+    let mut rig = Rig::new();
+    rig.master
+        .lss_switch_global(LssState::Configuration)
+        .unwrap();
+    rig.master.run_for(Duration::from_millis(20)).unwrap();
+    // CiA 305: switch state global (cs 0x04), mode 1 = configuration.
+    let lss = rig.seen(0x7E5);
+    assert_eq!(lss.len(), 1);
+    assert_eq!(lss[0].1.to_string(), "7E5#0401000000000000");
+    // No LSS slave on this bus: a confirmed request times out.
+    let e = rig.master.lss_store().unwrap_err();
+    assert!(matches!(e, blocking::LssRequestError::NoResponse), "{e}");
+}
+
+#[test]
+fn configure_pdo_runs_the_steps_through_the_master() {
+    let mut rig = Rig::new();
+    // TPDO1 of the device: on 0x1A0, synchronous every SYNC, mapping
+    // 0x2000:01 (32 bits).
+    let config = PdoConfig::new(PdoDirection::Tpdo, 1, 0x1A0, &[0x2000_0120])
+        .unwrap()
+        .with_transmission_type(1);
+    rig.master.configure_pdo(node(DEVICE), &config).unwrap();
+    // A mapping index outside the TPDO range: refused before anything is sent.
+    let mut bad = config;
+    bad.mapping_index = 0x1600;
+    let e = rig.master.configure_pdo(node(DEVICE), &bad).unwrap_err();
+    assert!(
+        e.to_string().starts_with("invalid PDO configuration"),
+        "{e}"
+    );
+}

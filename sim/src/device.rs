@@ -1,0 +1,608 @@
+//! The generic simulated device: everything CiA 301 asks of a slave, driven
+//! by its object table, with a [`Behaviour`] for the rest.
+
+mod dictionary;
+mod pdo;
+
+use std::collections::VecDeque;
+use std::time::Duration;
+
+use eds2rust_runtime::heartbeat::{HeartbeatConsumer, HeartbeatEvent, HeartbeatProducer};
+use eds2rust_runtime::lss::{BitRate, BitTiming, Identity, LssSlave, LssSlaveEvent};
+use eds2rust_runtime::nmt::{NmtCommand, NmtState, parse_command};
+use eds2rust_runtime::od::{NodeId, ObjectInfo};
+use eds2rust_runtime::sdo::Channel;
+use eds2rust_runtime::sdo::server::{SdoServer, ServerConfig, ServerEvent};
+use eds2rust_runtime::sync::parse_sync_on;
+use eds2rust_runtime::{CanId, Frame, Instant, Service};
+
+use crate::behaviour::Behaviour;
+use crate::store::{ObjectTable, SetError};
+use dictionary::Dictionary;
+use pdo::{Rpdo, Tpdo};
+
+/// EMCY code: PDO not processed due to length error (CiA 301).
+pub const EMCY_PDO_LENGTH: u16 = 0x8210;
+/// EMCY code: PDO length exceeded (CiA 301).
+pub const EMCY_PDO_LENGTH_EXCEEDED: u16 = 0x8220;
+
+/// How a simulated device starts.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct DeviceConfig {
+    /// The node id at power-on; `None`: unconfigured, the device answers
+    /// only LSS until a node id is configured and NMT resets communication.
+    pub node: Option<NodeId>,
+    /// The LSS address when the device is an LSS slave (CiA 305).
+    pub lss: Option<Identity>,
+    /// The bit rate it reports to LSS.
+    pub bit_rate: BitRate,
+}
+
+impl DeviceConfig {
+    /// A configured device at `node` without LSS.
+    pub const fn node(node: NodeId) -> DeviceConfig {
+        DeviceConfig {
+            node: Some(node),
+            lss: None,
+            bit_rate: BitRate::Kbit250,
+        }
+    }
+}
+
+/// What a simulated device reports.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SimEvent<E> {
+    /// Its NMT state changed.
+    Nmt {
+        /// Before.
+        from: NmtState,
+        /// After.
+        to: NmtState,
+    },
+    /// An entry was written from the bus (SDO or RPDO).
+    Written {
+        /// Object index.
+        index: u16,
+        /// Subindex.
+        sub: u8,
+    },
+    /// An SDO transfer ended (done or aborted).
+    Sdo(ServerEvent),
+    /// A consumed heartbeat was missed.
+    HeartbeatLost(NodeId),
+    /// A consumed heartbeat came back.
+    HeartbeatResumed(NodeId),
+    /// The device sent an EMCY with this code.
+    Emcy(u16),
+    /// LSS set a pending node id (active after reset communication).
+    LssNodeId(Option<NodeId>),
+    /// LSS store configuration: the pending node id survives power-off.
+    LssStored(Option<NodeId>),
+    /// The model tried to set an entry its table does not have.
+    ModelError(SetError),
+    /// An event of the model.
+    Model(E),
+}
+
+/// A simulated CANopen device (see the crate docs).
+#[derive(Debug)]
+pub struct Device<B: Behaviour> {
+    config: DeviceConfig,
+    server: SdoServer<Dictionary<B>>,
+    heartbeat: Option<HeartbeatProducer>,
+    consumer: HeartbeatConsumer,
+    lss: Option<LssSlave>,
+    /// The node id that survives a power cycle (LSS store).
+    stored_node: Option<NodeId>,
+    tpdos: Vec<Tpdo>,
+    rpdos: Vec<Rpdo>,
+    outbox: VecDeque<Frame>,
+    events: VecDeque<SimEvent<B::Event>>,
+    next_step: Instant,
+}
+
+impl<B: Behaviour> Device<B> {
+    /// Powers on a device whose dictionary is `objects` (a generated
+    /// `od::OBJECTS`) at `now`: it boots (boot-up message) and enters
+    /// pre-operational, unless unconfigured.
+    pub fn new(
+        objects: &'static [ObjectInfo],
+        config: DeviceConfig,
+        behaviour: B,
+        now: Instant,
+    ) -> Self {
+        let node = config.node;
+        let dictionary = Dictionary {
+            objects,
+            table: ObjectTable::new(objects, node),
+            behaviour,
+            effects: Default::default(),
+            now,
+            node,
+            nmt: NmtState::BootUp,
+            written: VecDeque::new(),
+            saved: None,
+        };
+        let lss = config
+            .lss
+            .map(|identity| LssSlave::new(identity, node, BitTiming::standard(config.bit_rate)));
+        let mut device = Device {
+            config,
+            server: SdoServer::new(server_config(node), dictionary),
+            heartbeat: None,
+            consumer: HeartbeatConsumer::new(),
+            lss,
+            stored_node: node,
+            tpdos: Vec::new(),
+            rpdos: Vec::new(),
+            outbox: VecDeque::new(),
+            events: VecDeque::new(),
+            next_step: now,
+        };
+        device.boot(now);
+        device
+    }
+
+    /// The node id in use (`None`: unconfigured).
+    pub fn node(&self) -> Option<NodeId> {
+        self.server.store().node
+    }
+
+    /// The NMT state.
+    pub fn nmt_state(&self) -> NmtState {
+        self.server.store().nmt
+    }
+
+    /// The object table.
+    pub fn table(&self) -> &ObjectTable {
+        &self.server.store().table
+    }
+
+    /// The model.
+    pub fn behaviour(&self) -> &B {
+        &self.server.store().behaviour
+    }
+
+    /// Runs `f` on the model with a context at `now`, as the device does
+    /// (for tests and examples that act on the device locally: a fault, a
+    /// button); what it asks for is sent on the next poll.
+    pub fn with_model<R>(
+        &mut self,
+        now: Instant,
+        f: impl FnOnce(&mut B, &mut crate::Context<'_, B::Event>) -> R,
+    ) -> R {
+        self.server.store_mut().now = now;
+        let r = self.server.store_mut().with_model(f);
+        self.after_input(now);
+        r
+    }
+
+    /// Switches the device off and on again at `now`: values not saved
+    /// (0x1010) return to their defaults, the LSS-stored node id is used.
+    pub fn power_cycle(&mut self, now: Instant) {
+        let node = self.stored_node;
+        if let Some(lss) = self.lss.as_mut() {
+            *lss = LssSlave::new(
+                lss.identity(),
+                node,
+                BitTiming::standard(self.config.bit_rate),
+            );
+        }
+        let d = self.server.store_mut();
+        d.node = node;
+        d.table = match &d.saved {
+            Some(saved) => saved.clone(),
+            None => ObjectTable::new(d.objects, node),
+        };
+        d.with_model(|b, ctx| b.reset_application(ctx));
+        self.restart(now);
+    }
+
+    /// Boot-up: NMT state pre-operational, boot-up message, heartbeat from
+    /// 0x1017, consumer from 0x1016.
+    fn boot(&mut self, now: Instant) {
+        let d = self.server.store_mut();
+        d.now = now;
+        let Some(node) = d.node else {
+            self.heartbeat = None;
+            return;
+        };
+        let period = d.table.get_uint(0x1017, 0).unwrap_or(0);
+        let mut producer = HeartbeatProducer::new(node, Duration::from_millis(period));
+        producer.start(now);
+        self.heartbeat = Some(producer);
+        self.configure_consumer();
+        self.set_nmt(now, NmtState::PreOperational);
+    }
+
+    /// Restarts communication after a reset at `now`: the SDO server moves
+    /// to the (possibly new) node id, PDOs and the consumer start afresh.
+    fn restart(&mut self, now: Instant) {
+        self.tpdos.clear();
+        self.rpdos.clear();
+        self.consumer = HeartbeatConsumer::new();
+        self.set_nmt(now, NmtState::BootUp);
+        let node = self.node();
+        self.server.set_channel(server_config(node).channel);
+        self.boot(now);
+    }
+
+    fn configure_consumer(&mut self) {
+        let table = &self.server.store().table;
+        let count = table.get_uint(0x1016, 0).unwrap_or(0) as u8;
+        let entries: Vec<u32> = (1..=count)
+            .filter_map(|sub| table.get_uint(0x1016, sub))
+            .map(|v| v as u32)
+            .collect();
+        self.consumer = HeartbeatConsumer::new();
+        self.consumer.configure(&entries);
+    }
+
+    fn set_nmt(&mut self, now: Instant, to: NmtState) {
+        let d = self.server.store_mut();
+        let from = d.nmt;
+        if from == to {
+            return;
+        }
+        d.nmt = to;
+        if let Some(hb) = self.heartbeat.as_mut() {
+            hb.set_state(to);
+        }
+        if to == NmtState::Operational {
+            self.load_pdos();
+        } else {
+            self.tpdos.clear();
+            self.rpdos.clear();
+        }
+        self.events.push_back(SimEvent::Nmt { from, to });
+        self.server
+            .store_mut()
+            .with_model(|b, ctx| b.nmt_changed(ctx, from, to));
+        self.after_input(now);
+    }
+
+    fn sync_cob_id(&self) -> u16 {
+        (self.table().get_uint(0x1005, 0).unwrap_or(0x80) & 0x7FF) as u16
+    }
+
+    fn load_pdos(&mut self) {
+        let sync = self.sync_cob_id();
+        self.tpdos = pdo::tpdos(self.table(), sync);
+        self.rpdos = pdo::rpdos(self.table());
+    }
+
+    fn emcy_cob_id(&self) -> Option<u16> {
+        let node = self.node()?;
+        match self.table().get_uint(0x1014, 0) {
+            Some(v) if v & 0x8000_0000 != 0 => None,
+            Some(v) => Some((v & 0x7FF) as u16),
+            None => Some(0x80 + u16::from(node.get())),
+        }
+    }
+
+    /// NMT commands, also while unconfigured (where only the resets matter).
+    fn handle_nmt(&mut self, now: Instant, cmd: NmtCommand) {
+        match cmd {
+            NmtCommand::ResetNode => {
+                if let Some(lss) = self.lss.as_mut() {
+                    lss.apply_pending();
+                }
+                let node = self
+                    .lss
+                    .as_ref()
+                    .map_or(self.node(), LssSlave::active_node_id);
+                let d = self.server.store_mut();
+                d.node = node;
+                d.table = match &d.saved {
+                    Some(saved) => saved.clone(),
+                    None => ObjectTable::new(d.objects, node),
+                };
+                d.with_model(|b, ctx| b.reset_application(ctx));
+                self.restart(now);
+            }
+            NmtCommand::ResetCommunication => {
+                if let Some(lss) = self.lss.as_mut() {
+                    lss.apply_pending();
+                }
+                let node = self
+                    .lss
+                    .as_ref()
+                    .map_or(self.node(), LssSlave::active_node_id);
+                let d = self.server.store_mut();
+                d.node = node;
+                match &d.saved {
+                    Some(saved) => {
+                        let saved = saved.clone();
+                        d.table.copy_range_from(&saved, 0x1000..=0x1FFF);
+                    }
+                    None => d.table.reset_to_defaults(0x1000..=0x1FFF, node),
+                }
+                self.restart(now);
+            }
+            _ if self.node().is_none() || self.nmt_state() == NmtState::BootUp => {}
+            NmtCommand::Start => self.set_nmt(now, NmtState::Operational),
+            NmtCommand::Stop => self.set_nmt(now, NmtState::Stopped),
+            NmtCommand::EnterPreOperational => self.set_nmt(now, NmtState::PreOperational),
+        }
+    }
+
+    /// After every input: take what was written and what the model asked
+    /// for, refresh the TPDO data.
+    fn after_input(&mut self, now: Instant) {
+        let written: Vec<(u16, u8)> = self.server.store_mut().written.drain(..).collect();
+        let mut pdo_changed = false;
+        for (index, sub) in written {
+            self.events.push_back(SimEvent::Written { index, sub });
+            match index {
+                0x1017 => {
+                    let ms = self.table().get_uint(0x1017, 0).unwrap_or(0);
+                    if let Some(hb) = self.heartbeat.as_mut() {
+                        hb.set_period(now, Duration::from_millis(ms));
+                    }
+                }
+                0x1016 => self.configure_consumer(),
+                0x1400..=0x1BFF => pdo_changed = true,
+                _ => {}
+            }
+        }
+        if pdo_changed && self.nmt_state() == NmtState::Operational {
+            self.load_pdos();
+        }
+        let effects = &mut self.server.store_mut().effects;
+        let emcy: Vec<[u8; 8]> = effects.emcy.drain(..).collect();
+        let errors: Vec<SetError> = effects.errors.drain(..).collect();
+        let model: Vec<B::Event> = effects.events.drain(..).collect();
+        let requests: Vec<u16> = effects.tpdo_requests.drain(..).collect();
+        let emcy_id = self.emcy_cob_id();
+        for data in emcy {
+            self.events
+                .push_back(SimEvent::Emcy(u16::from_le_bytes([data[0], data[1]])));
+            if let Some(id) = emcy_id
+                && self.nmt_state() != NmtState::Stopped
+                && let Ok(frame) = Frame::new(CanId::Standard(id), &data)
+            {
+                self.outbox.push_back(frame);
+            }
+        }
+        self.events
+            .extend(errors.into_iter().map(SimEvent::ModelError));
+        self.events.extend(model.into_iter().map(SimEvent::Model));
+        self.refresh_tpdos(now, &requests);
+    }
+
+    /// Packs each TPDO from the table; a changed value is an event for the
+    /// transmitter; requested TPDOs are sent now.
+    fn refresh_tpdos(&mut self, now: Instant, requests: &[u16]) {
+        let table = &self.server.store().table;
+        for tpdo in &mut self.tpdos {
+            let Some(data) = pdo::pack(table, &tpdo.mapping) else {
+                continue;
+            };
+            if tpdo.tx.data() != data.as_slice() {
+                let _ = tpdo.tx.set_data(now, &data);
+            }
+            if requests.contains(&tpdo.number)
+                && tpdo.tx.cob_id().valid
+                && let Ok(frame) = Frame::new(CanId::Standard(tpdo.tx.cob_id().id), &data)
+            {
+                self.outbox.push_back(frame);
+            }
+        }
+    }
+
+    fn receive_pdo(&mut self, now: Instant, frame: &Frame) -> bool {
+        let Some(id) = frame.cob_id() else {
+            return false;
+        };
+        let Some(i) = self.rpdos.iter().position(|r| r.cob_id == id) else {
+            return false;
+        };
+        if frame.is_remote() {
+            return true;
+        }
+        let need = self.rpdos[i].len();
+        let data = frame.data();
+        if data.len() < need {
+            self.device_emcy(now, EMCY_PDO_LENGTH);
+            return true;
+        }
+        if data.len() > need {
+            self.device_emcy(now, EMCY_PDO_LENGTH_EXCEEDED);
+        }
+        if self.rpdos[i].synchronous {
+            self.rpdos[i].pending = Some(data.to_vec());
+        } else {
+            self.apply_rpdo(i, data.to_vec());
+        }
+        true
+    }
+
+    fn apply_rpdo(&mut self, i: usize, data: Vec<u8>) {
+        let entries = pdo::unpack(&data, &self.rpdos[i].mapping);
+        let d = self.server.store_mut();
+        for (index, sub, value) in entries {
+            // A refused entry is dropped; CiA 301 has no answer for RPDOs.
+            let _ = d.bus_write(index, sub, &value);
+        }
+    }
+
+    fn device_emcy(&mut self, now: Instant, code: u16) {
+        let d = self.server.store_mut();
+        d.now = now;
+        d.with_model(|_, ctx| ctx.emcy(code, [0; 5]));
+    }
+
+    fn handle_sync(&mut self, now: Instant, frame: &Frame) {
+        for i in 0..self.rpdos.len() {
+            if let Some(data) = self.rpdos[i].pending.take() {
+                self.apply_rpdo(i, data);
+            }
+        }
+        self.server.store_mut().with_model(|b, ctx| b.sync(ctx));
+        self.after_input(now);
+        for tpdo in &mut self.tpdos {
+            tpdo.tx.handle_frame(now, frame);
+        }
+    }
+
+    fn handle_lss(&mut self, now: Instant, frame: &Frame) {
+        let Some(lss) = self.lss.as_mut() else {
+            return;
+        };
+        lss.handle_frame(now, frame);
+        while let Some(f) = lss.poll_transmit() {
+            self.outbox.push_back(f);
+        }
+        while let Some(event) = lss.poll_event() {
+            match event {
+                LssSlaveEvent::NodeIdChanged { pending } => {
+                    self.events.push_back(SimEvent::LssNodeId(pending));
+                }
+                LssSlaveEvent::StoreRequested => {
+                    self.stored_node = lss.pending_node_id();
+                    self.events.push_back(SimEvent::LssStored(self.stored_node));
+                }
+                _ => {}
+            }
+        }
+    }
+
+    fn run_step(&mut self, now: Instant) {
+        let period = self.behaviour().period().max(Duration::from_millis(1));
+        self.server.store_mut().with_model(|b, ctx| b.step(ctx));
+        self.next_step = now + period;
+        if self.next_step <= now {
+            self.next_step = now + Duration::from_millis(1);
+        }
+        self.after_input(now);
+    }
+}
+
+/// The server of `node`; an unconfigured device listens on the (unused)
+/// channel of node 0 and answers nothing.
+fn server_config(node: Option<NodeId>) -> ServerConfig {
+    let channel = match node {
+        Some(node) => Channel::default_for(node),
+        None => Channel {
+            request: 0x600,
+            response: 0x580,
+        },
+    };
+    ServerConfig::new(channel)
+}
+
+impl<B: Behaviour> Service for Device<B> {
+    type Event = SimEvent<B::Event>;
+
+    fn handle_frame(&mut self, now: Instant, frame: &Frame) {
+        self.server.store_mut().now = now;
+        self.handle_lss(now, frame);
+        if let Some((cmd, target)) = parse_command(frame) {
+            let me = self.node();
+            if target.is_none() || (target == me && me.is_some()) {
+                self.handle_nmt(now, cmd);
+            }
+            return;
+        }
+        if self.node().is_none() || self.nmt_state() == NmtState::BootUp {
+            return;
+        }
+        self.consumer.handle_frame(now, frame);
+        let nmt = self.nmt_state();
+        if nmt != NmtState::Stopped {
+            if parse_sync_on(self.sync_cob_id(), frame).is_some() {
+                if nmt == NmtState::Operational {
+                    self.handle_sync(now, frame);
+                }
+                return;
+            }
+            if nmt == NmtState::Operational && self.receive_pdo(now, frame) {
+                self.after_input(now);
+                return;
+            }
+            self.server.handle_frame(now, frame);
+        }
+        self.after_input(now);
+    }
+
+    fn handle_timeout(&mut self, now: Instant) {
+        self.server.store_mut().now = now;
+        if let Some(hb) = self.heartbeat.as_mut()
+            && hb.poll_timeout().is_some_and(|t| t <= now)
+        {
+            hb.handle_timeout(now);
+        }
+        if self.consumer.poll_timeout().is_some_and(|t| t <= now) {
+            self.consumer.handle_timeout(now);
+        }
+        if self.server.poll_timeout().is_some_and(|t| t <= now) {
+            self.server.handle_timeout(now);
+        }
+        for tpdo in &mut self.tpdos {
+            if tpdo.tx.poll_timeout().is_some_and(|t| t <= now) {
+                tpdo.tx.handle_timeout(now);
+            }
+        }
+        if self.next_step <= now {
+            self.run_step(now);
+        }
+    }
+
+    fn poll_transmit(&mut self) -> Option<Frame> {
+        if let Some(hb) = self.heartbeat.as_mut()
+            && let Some(f) = hb.poll_transmit()
+        {
+            return Some(f);
+        }
+        if let Some(f) = self.outbox.pop_front() {
+            return Some(f);
+        }
+        if let Some(f) = self.server.poll_transmit() {
+            return Some(f);
+        }
+        self.tpdos.iter_mut().find_map(|t| t.tx.poll_transmit())
+    }
+
+    fn poll_event(&mut self) -> Option<SimEvent<B::Event>> {
+        while let Some(e) = self.server.poll_event() {
+            self.events.push_back(SimEvent::Sdo(e));
+        }
+        while let Some(e) = self.consumer.poll_event() {
+            let now = self.server.store().now;
+            match e {
+                HeartbeatEvent::Timeout { node } => {
+                    self.events.push_back(SimEvent::HeartbeatLost(node));
+                    self.server
+                        .store_mut()
+                        .with_model(|b, ctx| b.heartbeat_lost(ctx, node));
+                    self.after_input(now);
+                }
+                HeartbeatEvent::Resumed { node, .. } => {
+                    self.events.push_back(SimEvent::HeartbeatResumed(node));
+                    self.server
+                        .store_mut()
+                        .with_model(|b, ctx| b.heartbeat_resumed(ctx, node));
+                    self.after_input(now);
+                }
+                HeartbeatEvent::State { .. } => {}
+            }
+        }
+        self.events.pop_front()
+    }
+
+    fn poll_timeout(&self) -> Option<Instant> {
+        let mut at = Some(self.next_step);
+        let mut take = |t: Option<Instant>| {
+            if let Some(t) = t {
+                at = Some(at.map_or(t, |a| a.min(t)));
+            }
+        };
+        take(self.heartbeat.as_ref().and_then(Service::poll_timeout));
+        take(self.consumer.poll_timeout());
+        take(self.server.poll_timeout());
+        for tpdo in &self.tpdos {
+            take(tpdo.tx.poll_timeout());
+        }
+        at
+    }
+}

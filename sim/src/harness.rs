@@ -1,0 +1,304 @@
+//! What the examples share: the command line (`--iface`, `--trace`,
+//! `--simulate`, `--time-scale`), a bus for the master, the simulator
+//! running in a thread, and the trace of every frame in candump's compact
+//! form.
+//!
+//! Without `--iface` everything runs on an in-process
+//! [`VirtualBus`](eds2rust_runtime::transport::virtual_bus::VirtualBus): the
+//! master gets one port, the simulator another, the tracer a third. With
+//! `--iface NAME` the master opens the SocketCAN interface `NAME` (Linux);
+//! the simulator runs there too only with `--simulate` (for a vcan
+//! interface), otherwise the real device is expected on the bus.
+
+use std::fmt;
+use std::io;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex, PoisonError};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
+use eds2rust_runtime::transport::{Bus, Clock};
+use eds2rust_runtime::{Frame, Instant, blocking};
+
+use crate::{Behaviour, Device, SimEvent};
+
+/// The examples' command line.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Args {
+    /// SocketCAN interface to use instead of the virtual bus.
+    pub iface: Option<String>,
+    /// Print every frame on the bus, one per line, in candump's compact
+    /// form (`720#00`).
+    pub trace: bool,
+    /// With `iface`: run the simulated device on that interface as well.
+    pub simulate: bool,
+    /// How much faster than real time the simulated mechanics move (1.0:
+    /// as the manual says).
+    pub time_scale: f64,
+}
+
+impl Default for Args {
+    fn default() -> Self {
+        Args {
+            iface: None,
+            trace: false,
+            simulate: false,
+            time_scale: 1.0,
+        }
+    }
+}
+
+/// A command line that could not be understood.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct ArgsError(pub String);
+
+impl fmt::Display for ArgsError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{}\nusage: [--iface NAME [--simulate]] [--trace] [--time-scale FACTOR]",
+            self.0
+        )
+    }
+}
+
+impl std::error::Error for ArgsError {}
+
+impl Args {
+    /// Parses the arguments after the program name.
+    pub fn parse(args: impl IntoIterator<Item = String>) -> Result<Args, ArgsError> {
+        let mut out = Args::default();
+        let mut args = args.into_iter();
+        while let Some(arg) = args.next() {
+            match arg.as_str() {
+                "--trace" => out.trace = true,
+                "--simulate" => out.simulate = true,
+                "--iface" => {
+                    let name = args
+                        .next()
+                        .ok_or_else(|| ArgsError("--iface needs an interface name".into()))?;
+                    out.iface = Some(name);
+                }
+                "--time-scale" => {
+                    let value = args
+                        .next()
+                        .ok_or_else(|| ArgsError("--time-scale needs a factor".into()))?;
+                    out.time_scale = value
+                        .parse()
+                        .ok()
+                        .filter(|v: &f64| v.is_finite() && *v > 0.0)
+                        .ok_or_else(|| {
+                            ArgsError(format!("--time-scale {value}: not a positive number"))
+                        })?;
+                }
+                other => return Err(ArgsError(format!("unknown argument `{other}`"))),
+            }
+        }
+        if out.simulate && out.iface.is_none() {
+            return Err(ArgsError(
+                "--simulate goes with --iface (the virtual bus always simulates)".into(),
+            ));
+        }
+        Ok(out)
+    }
+
+    /// Parses the process's arguments.
+    pub fn from_env() -> Result<Args, ArgsError> {
+        Args::parse(std::env::args().skip(1))
+    }
+
+    /// Whether a simulator runs (always on the virtual bus).
+    pub fn simulates(&self) -> bool {
+        self.iface.is_none() || self.simulate
+    }
+}
+
+/// The master's end of the bus.
+#[derive(Debug)]
+pub enum MasterPort {
+    /// A port of the in-process virtual bus.
+    Virtual(VirtualPort),
+    /// A SocketCAN socket (Linux).
+    #[cfg(target_os = "linux")]
+    SocketCan(eds2rust_runtime::transport::socketcan::SocketCanBus),
+}
+
+impl Bus for MasterPort {
+    fn send(&mut self, frame: &Frame) -> io::Result<()> {
+        match self {
+            MasterPort::Virtual(p) => p.send(frame),
+            #[cfg(target_os = "linux")]
+            MasterPort::SocketCan(s) => s.send(frame),
+        }
+    }
+
+    fn recv(&mut self, timeout: Duration) -> io::Result<Option<Frame>> {
+        match self {
+            MasterPort::Virtual(p) => p.recv(timeout),
+            #[cfg(target_os = "linux")]
+            MasterPort::SocketCan(s) => s.recv(timeout),
+        }
+    }
+}
+
+/// Lines shared between the threads.
+type Lines = Arc<Mutex<Vec<String>>>;
+
+fn push(lines: &Lines, line: String) {
+    lines
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+        .push(line);
+}
+
+/// A running example setup: bus, simulator thread and tracer thread.
+#[derive(Debug)]
+pub struct Harness {
+    clock: Clock,
+    port: Option<MasterPort>,
+    stop: Arc<AtomicBool>,
+    threads: Vec<JoinHandle<io::Result<()>>>,
+    trace: Lines,
+    device_log: Lines,
+}
+
+impl Harness {
+    /// Opens the bus and, when [`Args::simulates`], starts the device that
+    /// `device` builds (given the power-on time) in a thread.
+    pub fn start<B, F>(args: &Args, device: F) -> io::Result<Harness>
+    where
+        B: Behaviour + Send + 'static,
+        B::Event: Send,
+        F: FnOnce(Instant) -> Device<B>,
+    {
+        let clock = Clock::new();
+        let mut harness = Harness {
+            clock,
+            port: None,
+            stop: Arc::new(AtomicBool::new(false)),
+            threads: Vec::new(),
+            trace: Lines::default(),
+            device_log: Lines::default(),
+        };
+        match &args.iface {
+            None => {
+                let bus = VirtualBus::new();
+                harness.port = Some(MasterPort::Virtual(bus.attach()));
+                harness.spawn_tracer(MasterPort::Virtual(bus.attach()), args.trace);
+                harness.spawn_device(MasterPort::Virtual(bus.attach()), device(clock.now()));
+            }
+            #[cfg(target_os = "linux")]
+            Some(name) => {
+                use eds2rust_runtime::transport::socketcan::SocketCanBus;
+                let open = |name: &str| {
+                    SocketCanBus::open(name).map_err(|e| {
+                        io::Error::new(e.kind(), format!("SocketCAN interface `{name}`: {e}"))
+                    })
+                };
+                harness.port = Some(MasterPort::SocketCan(open(name)?));
+                harness.spawn_tracer(MasterPort::SocketCan(open(name)?), args.trace);
+                if args.simulate {
+                    harness.spawn_device(MasterPort::SocketCan(open(name)?), device(clock.now()));
+                }
+            }
+            #[cfg(not(target_os = "linux"))]
+            Some(name) => {
+                return Err(io::Error::new(
+                    io::ErrorKind::Unsupported,
+                    format!("SocketCAN interface `{name}`: SocketCAN needs Linux"),
+                ));
+            }
+        }
+        Ok(harness)
+    }
+
+    fn spawn_tracer(&mut self, mut port: MasterPort, print: bool) {
+        let stop = Arc::clone(&self.stop);
+        let trace = Arc::clone(&self.trace);
+        self.threads.push(std::thread::spawn(move || {
+            while !stop.load(Ordering::Relaxed) {
+                if let Some(frame) = port.recv(Duration::from_millis(20))? {
+                    let line = frame.to_string();
+                    if print {
+                        println!("{line}");
+                    }
+                    push(&trace, line);
+                }
+            }
+            // Frames sent just before the stop.
+            while let Some(frame) = port.recv(Duration::from_millis(5))? {
+                let line = frame.to_string();
+                if print {
+                    println!("{line}");
+                }
+                push(&trace, line);
+            }
+            Ok(())
+        }));
+    }
+
+    fn spawn_device<B>(&mut self, mut port: MasterPort, mut device: Device<B>)
+    where
+        B: Behaviour + Send + 'static,
+        B::Event: Send,
+    {
+        let stop = Arc::clone(&self.stop);
+        let log = Arc::clone(&self.device_log);
+        let clock = self.clock;
+        self.threads.push(std::thread::spawn(move || {
+            blocking::serve(&mut port, &clock, &mut device, &stop, None, |event| {
+                if !matches!(event, SimEvent::Sdo(_) | SimEvent::Written { .. }) {
+                    push(&log, format!("{event:?}"));
+                }
+            })
+        }));
+    }
+
+    /// The clock master and simulator share.
+    pub fn clock(&self) -> Clock {
+        self.clock
+    }
+
+    /// The master's port (once).
+    pub fn take_port(&mut self) -> io::Result<MasterPort> {
+        self.port
+            .take()
+            .ok_or_else(|| io::Error::other("the master port was already taken"))
+    }
+
+    /// The frames traced so far, in candump's compact form.
+    pub fn trace(&self) -> Vec<String> {
+        self.trace
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
+
+    /// The simulator's events so far (Debug form), without SDO and write
+    /// events.
+    pub fn device_log(&self) -> Vec<String> {
+        self.device_log
+            .lock()
+            .unwrap_or_else(PoisonError::into_inner)
+            .clone()
+    }
+
+    /// Stops the simulator and tracer and returns the whole trace; a thread
+    /// that failed (a bus error) is reported.
+    pub fn stop(mut self) -> io::Result<Vec<String>> {
+        self.stop.store(true, Ordering::Relaxed);
+        for thread in self.threads.drain(..) {
+            thread
+                .join()
+                .map_err(|_| io::Error::other("a simulator thread panicked"))??;
+        }
+        Ok(self.trace())
+    }
+}
+
+impl Drop for Harness {
+    fn drop(&mut self) {
+        self.stop.store(true, Ordering::Relaxed);
+    }
+}

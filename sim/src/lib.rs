@@ -1,0 +1,28 @@
+//! eds2rust-sim: simulated CANopen devices, for examples, tests and
+//! commissioning without hardware.
+//!
+//! - [`Device`] is a generic CiA 301 device built from a generated
+//!   `od::OBJECTS` table: an SDO server over an [`ObjectTable`] that
+//!   enforces access rights, types and limits; NMT slave with boot-up and
+//!   heartbeat (0x1017), heartbeat consumer (0x1016); TPDOs and RPDOs from
+//!   the communication and mapping parameters in the table (reconfigurable
+//!   over SDO with the CiA 301 rules); EMCY; SYNC; and, when configured,
+//!   an LSS slave (CiA 305). It is a sans-IO [`Service`](eds2rust_runtime::Service)
+//!   like the runtime's cores, so tests drive it on a virtual clock and
+//!   examples run it on a bus in a thread.
+//! - A [`Behaviour`] adds what the device does: [`models`] has the three
+//!   seed devices, written from their manuals.
+//! - [`harness`] runs a simulator and a master on the virtual bus (or on a
+//!   SocketCAN interface), with an optional candump-style trace.
+#![warn(missing_docs)]
+
+pub mod behaviour;
+pub mod bench;
+pub mod device;
+pub mod harness;
+pub mod models;
+pub mod store;
+
+pub use behaviour::{Behaviour, Context};
+pub use device::{Device, DeviceConfig, SimEvent};
+pub use store::ObjectTable;
