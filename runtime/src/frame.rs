@@ -60,6 +60,8 @@ impl fmt::Display for FrameError {
     }
 }
 
+impl core::error::Error for FrameError {}
+
 /// A classic CAN data or remote frame (at most 8 data bytes).
 #[derive(Clone, Copy, PartialEq, Eq, Hash)]
 pub struct Frame {

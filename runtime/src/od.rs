@@ -443,6 +443,8 @@ impl fmt::Display for PdoLengthError {
     }
 }
 
+impl core::error::Error for PdoLengthError {}
+
 /// A generated default-PDO struct.
 pub trait Pdo: Sized {
     const DIRECTION: PdoDirection;

@@ -280,19 +280,25 @@ impl<B: Behaviour> Device<B> {
         }
     }
 
+    /// At a reset: the node id LSS configured becomes the one in use.
+    fn take_pending_node_id(&mut self) -> Option<NodeId> {
+        if let Some(lss) = self.lss.as_mut() {
+            lss.apply_pending();
+        }
+        let node = self
+            .lss
+            .as_ref()
+            .map_or(self.node(), LssSlave::active_node_id);
+        self.server.store_mut().node = node;
+        node
+    }
+
     /// NMT commands, also while unconfigured (where only the resets matter).
     fn handle_nmt(&mut self, now: Instant, cmd: NmtCommand) {
         match cmd {
             NmtCommand::ResetNode => {
-                if let Some(lss) = self.lss.as_mut() {
-                    lss.apply_pending();
-                }
-                let node = self
-                    .lss
-                    .as_ref()
-                    .map_or(self.node(), LssSlave::active_node_id);
+                let node = self.take_pending_node_id();
                 let d = self.server.store_mut();
-                d.node = node;
                 d.table = match &d.saved {
                     Some(saved) => saved.clone(),
                     None => ObjectTable::new(d.objects, node),
@@ -301,15 +307,8 @@ impl<B: Behaviour> Device<B> {
                 self.restart(now);
             }
             NmtCommand::ResetCommunication => {
-                if let Some(lss) = self.lss.as_mut() {
-                    lss.apply_pending();
-                }
-                let node = self
-                    .lss
-                    .as_ref()
-                    .map_or(self.node(), LssSlave::active_node_id);
+                let node = self.take_pending_node_id();
                 let d = self.server.store_mut();
-                d.node = node;
                 match &d.saved {
                     Some(saved) => {
                         let saved = saved.clone();
@@ -453,6 +452,7 @@ impl<B: Behaviour> Device<B> {
         while let Some(f) = lss.poll_transmit() {
             self.outbox.push_back(f);
         }
+        let mut reset = false;
         while let Some(event) = lss.poll_event() {
             match event {
                 LssSlaveEvent::NodeIdChanged { pending } => {
@@ -462,8 +462,14 @@ impl<B: Behaviour> Device<B> {
                     self.stored_node = lss.pending_node_id();
                     self.events.push_back(SimEvent::LssStored(self.stored_node));
                 }
+                LssSlaveEvent::ResetCommunication => reset = true,
                 _ => {}
             }
+        }
+        // CiA 305: an unconfigured device that got a node id resets its
+        // communication when switched back to waiting.
+        if reset {
+            self.handle_nmt(now, NmtCommand::ResetCommunication);
         }
     }
 

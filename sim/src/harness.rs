@@ -3,8 +3,8 @@
 //! running in a thread, and the trace of every frame in candump's compact
 //! form.
 //!
-//! Without `--iface` everything runs on an in-process
-//! [`VirtualBus`](eds2rust_runtime::transport::virtual_bus::VirtualBus): the
+//! Without `--iface` everything runs on an in-process virtual bus
+//! ([`eds2rust_runtime::transport::virtual_bus`]): the
 //! master gets one port, the simulator another, the tracer a third. With
 //! `--iface NAME` the master opens the SocketCAN interface `NAME` (Linux);
 //! the simulator runs there too only with `--simulate` (for a vcan
@@ -19,7 +19,7 @@ use std::time::Duration;
 
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use eds2rust_runtime::transport::{Bus, Clock};
-use eds2rust_runtime::{Frame, Instant, blocking};
+use eds2rust_runtime::{Frame, Instant, Service, blocking};
 
 use crate::{Behaviour, Device, SimEvent};
 
@@ -186,7 +186,7 @@ impl Harness {
                 let bus = VirtualBus::new();
                 harness.port = Some(MasterPort::Virtual(bus.attach()));
                 harness.spawn_tracer(MasterPort::Virtual(bus.attach()), args.trace);
-                harness.spawn_device(MasterPort::Virtual(bus.attach()), device(clock.now()));
+                harness.spawn_device(MasterPort::Virtual(bus.attach()), device(clock.now()))?;
             }
             #[cfg(target_os = "linux")]
             Some(name) => {
@@ -199,7 +199,8 @@ impl Harness {
                 harness.port = Some(MasterPort::SocketCan(open(name)?));
                 harness.spawn_tracer(MasterPort::SocketCan(open(name)?), args.trace);
                 if args.simulate {
-                    harness.spawn_device(MasterPort::SocketCan(open(name)?), device(clock.now()));
+                    harness
+                        .spawn_device(MasterPort::SocketCan(open(name)?), device(clock.now()))?;
                 }
             }
             #[cfg(not(target_os = "linux"))]
@@ -238,11 +239,17 @@ impl Harness {
         }));
     }
 
-    fn spawn_device<B>(&mut self, mut port: MasterPort, mut device: Device<B>)
+    /// Runs `device` on `port` in a thread. Its boot-up message is sent
+    /// before this returns, so that it precedes the master's first frame as
+    /// on a bus where the device was powered first.
+    fn spawn_device<B>(&mut self, mut port: MasterPort, mut device: Device<B>) -> io::Result<()>
     where
         B: Behaviour + Send + 'static,
         B::Event: Send,
     {
+        while let Some(frame) = device.poll_transmit() {
+            port.send(&frame)?;
+        }
         let stop = Arc::clone(&self.stop);
         let log = Arc::clone(&self.device_log);
         let clock = self.clock;
@@ -253,6 +260,7 @@ impl Harness {
                 }
             })
         }));
+        Ok(())
     }
 
     /// The clock master and simulator share.

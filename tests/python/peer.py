@@ -130,16 +130,22 @@ class Peer:
                 # would silently detach the LocalNode.
                 raise ValueError("node %d is a LocalNode of this peer" % node)
             if found is None:
-                found = canopen.RemoteNode(node, ObjectDictionary())
-                heard = self.heard.setdefault(node, [])
-
-                def on_heartbeat(state, heard=heard):
-                    if len(heard) < HEARD_KEPT:
-                        heard.append(state)
-                found.nmt.add_heartbeat_callback(on_heartbeat)
-                self.network.add_node(found)
-                self.remote[node] = found
+                found = self._add_remote(node, ObjectDictionary())
             return found
+
+    def _add_remote(self, node, od):
+        """Adds a RemoteNode with dictionary `od` (an ObjectDictionary or an
+        EDS path) that records its heartbeats; the caller holds the lock."""
+        remote = canopen.RemoteNode(node, od)
+        heard = self.heard.setdefault(node, [])
+
+        def on_heartbeat(state, heard=heard):
+            if len(heard) < HEARD_KEPT:
+                heard.append(state)
+        remote.nmt.add_heartbeat_callback(on_heartbeat)
+        self.network.add_node(remote)
+        self.remote[node] = remote
+        return remote
 
     # Commands ------------------------------------------------------------
 
@@ -338,15 +344,7 @@ class Peer:
             old = self.remote.pop(node, None)
             if old is not None:
                 self.network.nodes.pop(node, None)
-            remote = canopen.RemoteNode(node, cmd["eds"])
-            heard = self.heard.setdefault(node, [])
-
-            def on_heartbeat(state, heard=heard):
-                if len(heard) < HEARD_KEPT:
-                    heard.append(state)
-            remote.nmt.add_heartbeat_callback(on_heartbeat)
-            self.network.add_node(remote)
-            self.remote[node] = remote
+            self._add_remote(node, cmd["eds"])
         return {}
 
     def op_tpdo_read(self, cmd):
