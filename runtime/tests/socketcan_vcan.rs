@@ -1,0 +1,289 @@
+//! [`SocketCanBus`] against the kernel's SocketCAN stack: classic frames
+//! between two sockets, kernel filters, receive timeouts, and SDO transfers
+//! (expedited, segmented, block) between the blocking client and a served
+//! SDO server.
+//!
+//! These tests need a real CAN interface and are ignored by default:
+//! `tests/vm/run.sh` runs them with `--ignored` inside a VM whose kernel has
+//! vcan. Each test takes its own interface from `CAN_IFACES` (a
+//! space-separated list, index per test); with only `CAN_IFACE` set they all
+//! share that one, so run them with `--test-threads=1`.
+#![cfg(all(target_os = "linux", feature = "socketcan"))]
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+use eds2rust_runtime::blocking::{self, SdoClient};
+use eds2rust_runtime::od::{AccessRight, NodeId};
+use eds2rust_runtime::sdo::Channel;
+use eds2rust_runtime::sdo::client::{ClientConfig, Method};
+use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
+use eds2rust_runtime::transport::socketcan::SocketCanBus;
+use eds2rust_runtime::transport::{Bus, Clock};
+use eds2rust_runtime::{CanId, Frame};
+
+/// Interface indices in `CAN_IFACES`, one per test.
+const FRAMES: usize = 0;
+const FILTERS: usize = 1;
+const TIMEOUTS: usize = 2;
+const SDO: usize = 3;
+
+/// Waits for frames that must arrive; generous for an emulated VM.
+const ARRIVAL: Duration = Duration::from_secs(2);
+/// Waits for frames that must not arrive.
+const QUIET: Duration = Duration::from_millis(100);
+
+/// The interface of test `index`: the `index`th entry of `CAN_IFACES`, or
+/// else `CAN_IFACE`. Panics with what to set when neither is there.
+fn iface(index: usize) -> String {
+    if let Ok(list) = std::env::var("CAN_IFACES") {
+        let names: Vec<&str> = list.split([' ', ',']).filter(|s| !s.is_empty()).collect();
+        if let Some(name) = names.get(index) {
+            return (*name).to_string();
+        }
+        panic!(
+            "CAN_IFACES={list:?} names {} interfaces; this test uses entry {index}",
+            names.len()
+        );
+    }
+    match std::env::var("CAN_IFACE") {
+        Ok(name) if !name.is_empty() => name,
+        _ => panic!(
+            "no CAN interface: set CAN_IFACE (one, with --test-threads=1) or CAN_IFACES \
+             (one per test) to SocketCAN interfaces such as vcan0; tests/vm/run.sh does"
+        ),
+    }
+}
+
+fn open(name: &str) -> SocketCanBus {
+    SocketCanBus::open(name).unwrap_or_else(|e| panic!("{e}"))
+}
+
+/// Reads and drops whatever a socket received before its filter was set.
+fn drain(bus: &mut SocketCanBus) {
+    while bus.recv(Duration::ZERO).unwrap().is_some() {}
+}
+
+fn std_frame(id: u16, data: &[u8]) -> Frame {
+    Frame::new(CanId::Standard(id), data).unwrap()
+}
+
+#[test]
+#[ignore = "needs a SocketCAN interface in CAN_IFACE: run by tests/vm/run.sh"]
+fn classic_frames_pass_between_two_sockets() {
+    let name = iface(FRAMES);
+    let mut a = open(&name);
+    let mut b = open(&name);
+    assert_eq!(a.interface(), name);
+
+    let payload = [0x11, 0x22, 0x33, 0x44, 0x55, 0x66, 0x77, 0x88];
+    let mut sent = Vec::new();
+    for len in 0..=8 {
+        sent.push(std_frame(0x123, &payload[..len]));
+    }
+    sent.push(std_frame(0x000, &[0xFF]));
+    sent.push(std_frame(0x7FF, &[0x00, 0x01]));
+    sent.push(Frame::new(CanId::Extended(0x1ABC_DEF0), &payload).unwrap());
+    sent.push(Frame::new(CanId::Extended(0x0000_0123), &[]).unwrap());
+    sent.push(Frame::new(CanId::Extended(0x1FFF_FFFF), &[0xA5; 3]).unwrap());
+    sent.push(Frame::remote(CanId::Standard(0x701), 1).unwrap());
+    sent.push(Frame::remote(CanId::Standard(0x123), 0).unwrap());
+    sent.push(Frame::remote(CanId::Extended(0x18FF_0001), 8).unwrap());
+    for frame in &sent {
+        a.send(frame).unwrap();
+    }
+    for frame in &sent {
+        let got = b.recv(ARRIVAL).unwrap();
+        assert_eq!(got.as_ref(), Some(frame), "expected {frame}");
+    }
+    assert_eq!(b.recv(QUIET).unwrap(), None);
+    // A raw socket does not receive its own frames (CAN_RAW_RECV_OWN_MSGS
+    // is off by default).
+    assert_eq!(a.recv(QUIET).unwrap(), None);
+
+    // The other way, checked on the wire through the socketcan crate.
+    use socketcan::{EmbeddedFrame, Frame as _, Id, Socket, StandardId};
+    b.send(&std_frame(0x181, &[0x01, 0x02, 0x03])).unwrap();
+    let raw = a.socket().read_frame_timeout(ARRIVAL).unwrap();
+    assert_eq!(raw.id(), Id::Standard(StandardId::new(0x181).unwrap()));
+    assert_eq!(raw.data(), [0x01, 0x02, 0x03]);
+    assert!(!raw.is_remote_frame() && !raw.is_extended());
+    b.send(&Frame::remote(CanId::Extended(0x0ABC_0001), 4).unwrap())
+        .unwrap();
+    let raw = a.socket().read_frame_timeout(ARRIVAL).unwrap();
+    assert_eq!(raw.can_id().as_raw(), 0x0ABC_0001);
+    assert!(raw.is_remote_frame() && raw.is_extended());
+    assert_eq!(raw.dlc(), 4);
+}
+
+#[test]
+#[ignore = "needs a SocketCAN interface in CAN_IFACE: run by tests/vm/run.sh"]
+fn filters_admit_only_chosen_ids() {
+    let name = iface(FILTERS);
+    let mut tx = open(&name);
+    // 0x581 exactly, and 0x180..=0x1FF (TPDO1 of every node).
+    let mut rx = open(&name)
+        .set_filters(&[(0x581, 0x7FF), (0x180, 0x780)])
+        .unwrap();
+    drain(&mut rx);
+    let mut none = open(&name).set_filters(&[]).unwrap();
+    drain(&mut none);
+
+    let admitted = [
+        std_frame(0x581, &[0x43, 0x00, 0x10, 0x00, 0x91, 0x01, 0x0F, 0x00]),
+        std_frame(0x180, &[0x01]),
+        std_frame(0x1FF, &[]),
+        Frame::remote(CanId::Standard(0x181), 2).unwrap(),
+    ];
+    let refused = [
+        std_frame(0x580, &[0x01]),
+        std_frame(0x582, &[0x02]),
+        std_frame(0x17F, &[0x03]),
+        std_frame(0x200, &[0x04]),
+        std_frame(0x601, &[0x05]),
+        // Extended frames never pass, even with a matching low part.
+        Frame::new(CanId::Extended(0x581), &[0x06]).unwrap(),
+        Frame::new(CanId::Extended(0x1000_0181), &[0x07]).unwrap(),
+    ];
+    // Interleaved, so that order and selection are both checked.
+    for (i, frame) in refused.iter().enumerate() {
+        tx.send(frame).unwrap();
+        if let Some(good) = admitted.get(i) {
+            tx.send(good).unwrap();
+        }
+    }
+    for frame in &admitted {
+        assert_eq!(rx.recv(ARRIVAL).unwrap().as_ref(), Some(frame));
+    }
+    assert_eq!(rx.recv(QUIET).unwrap(), None);
+    assert_eq!(none.recv(QUIET).unwrap(), None);
+}
+
+#[test]
+#[ignore = "needs a SocketCAN interface in CAN_IFACE: run by tests/vm/run.sh"]
+fn recv_times_out_with_none() {
+    let name = iface(TIMEOUTS);
+    let mut bus = open(&name).set_filters(&[(0x7E5, 0x7FF)]).unwrap();
+    drain(&mut bus);
+    for wait in [
+        Duration::ZERO,
+        Duration::from_millis(50),
+        Duration::from_millis(300),
+    ] {
+        let start = Instant::now();
+        assert_eq!(bus.recv(wait).unwrap(), None);
+        let took = start.elapsed();
+        assert!(took >= wait, "recv({wait:?}) returned after {took:?}");
+        // Generous: the VM emulates its CPU.
+        assert!(
+            took < wait + Duration::from_millis(500),
+            "recv({wait:?}) took {took:?}"
+        );
+    }
+    // A frame that arrives while waiting ends the wait early.
+    let mut tx = open(&name);
+    let sender = std::thread::spawn(move || {
+        std::thread::sleep(Duration::from_millis(100));
+        tx.send(&std_frame(0x7E5, &[0x04, 0x05])).unwrap();
+    });
+    let start = Instant::now();
+    let got = bus.recv(Duration::from_secs(5)).unwrap();
+    sender.join().unwrap();
+    assert_eq!(got, Some(std_frame(0x7E5, &[0x04, 0x05])));
+    assert!(start.elapsed() < Duration::from_secs(4));
+}
+
+#[test]
+#[ignore = "needs a SocketCAN interface in CAN_IFACE: run by tests/vm/run.sh"]
+fn sdo_transfers_between_client_and_served_server() {
+    let name = iface(SDO);
+    let node = NodeId::new(5).unwrap();
+    let channel = Channel::default_for(node);
+    assert_eq!((channel.request, channel.response), (0x605, 0x585));
+
+    let long: Vec<u8> = (0..1000u32).map(|i| (i * 7 + 3) as u8).collect();
+    let text = b"eds2rust over vcan!".to_vec();
+    let mut store = MemoryStore::new();
+    store.insert(0x2000, 1, AccessRight::Rw, &[0x11, 0x22, 0x33, 0x44]);
+    store.insert(0x2001, 0, AccessRight::Rw, &text);
+    store.insert(0x2002, 0, AccessRight::Rw, &long);
+    store.insert(0x2003, 0, AccessRight::Rw, &[0x00]);
+    store.insert(0x2004, 0, AccessRight::Rw, &[0x00]);
+
+    // Sees every frame of the transfers.
+    let mut sniffer = open(&name);
+    let server_bus = open(&name)
+        .set_filters(&[(channel.request, 0x7FF)])
+        .unwrap();
+    let client_bus = open(&name)
+        .set_filters(&[(channel.response, 0x7FF)])
+        .unwrap();
+
+    let stop = Arc::new(AtomicBool::new(false));
+    let server_stop = Arc::clone(&stop);
+    let server = std::thread::spawn(move || {
+        let mut bus = server_bus;
+        let mut server = SdoServer::new(ServerConfig::new(channel), store);
+        let deadline = Instant::now() + Duration::from_secs(60);
+        blocking::serve(
+            &mut bus,
+            &Clock::new(),
+            &mut server,
+            &server_stop,
+            Some(deadline),
+            |_| {},
+        )
+        .map(|()| server.into_store())
+    });
+
+    let mut client = SdoClient::new(client_bus, ClientConfig::new(channel));
+    let results = (|| -> Result<(), blocking::Error> {
+        // Expedited both ways.
+        assert_eq!(client.upload(0x2000, 1)?, [0x11, 0x22, 0x33, 0x44]);
+        client.download(0x2003, 0, &[0xA1, 0xB2])?;
+        // Segmented both ways.
+        assert_eq!(client.upload_with(0x2001, 0, Method::Standard)?, text);
+        client.download_with(0x2004, 0, b"segmented!", Method::Segmented)?;
+        // Block both ways.
+        assert_eq!(client.upload_with(0x2002, 0, Method::Block)?, long);
+        let back: Vec<u8> = long.iter().rev().copied().collect();
+        client.download_with(0x2002, 0, &back, Method::Block)?;
+        assert_eq!(client.upload_with(0x2002, 0, Method::Block)?, back);
+        Ok(())
+    })();
+    stop.store(true, Ordering::Relaxed);
+    let store = server.join().unwrap().unwrap();
+    results.unwrap();
+    assert_eq!(store.get(0x2003, 0), Some(&[0xA1, 0xB2][..]));
+    assert_eq!(store.get(0x2004, 0), Some(&b"segmented!"[..]));
+
+    // CiA 301 on the wire: the expedited upload is an initiate request
+    // (ccs 2) and a response with e = 1, s = 1 and n = 0 (4 bytes).
+    let request = sniffer.recv(ARRIVAL).unwrap();
+    assert_eq!(
+        request,
+        Some(std_frame(0x605, &[0x40, 0x00, 0x20, 0x01, 0, 0, 0, 0]))
+    );
+    let response = sniffer.recv(ARRIVAL).unwrap();
+    assert_eq!(
+        response,
+        Some(std_frame(
+            0x585,
+            &[0x43, 0x00, 0x20, 0x01, 0x11, 0x22, 0x33, 0x44]
+        ))
+    );
+    // The expedited download: ccs 1, e = 1, s = 1, n = 2 (0x2B), answered
+    // by scs 3 (0x60).
+    assert_eq!(
+        sniffer.recv(ARRIVAL).unwrap(),
+        Some(std_frame(
+            0x605,
+            &[0x2B, 0x03, 0x20, 0x00, 0xA1, 0xB2, 0, 0]
+        ))
+    );
+    assert_eq!(
+        sniffer.recv(ARRIVAL).unwrap(),
+        Some(std_frame(0x585, &[0x60, 0x03, 0x20, 0x00, 0, 0, 0, 0]))
+    );
+}

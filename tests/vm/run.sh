@@ -1,0 +1,289 @@
+#!/usr/bin/env bash
+# Runs the SocketCAN tests against the real kernel CAN stack: boots Debian's
+# generic kernel in qemu (software emulation) with an initramfs holding
+# busybox, the CAN modules and static test binaries, creates vcan0..vcanN
+# and runs the tests there (see tests/vm/README.md).
+#
+# Usage: tests/vm/run.sh [ARGS...]   (ARGS go to every test binary, after
+#                                     --ignored)
+# Exit status: 0 the tests passed, 1 a test failed inside the VM,
+#              2 infrastructure failure (apt, download, build, boot,
+#                timeout, missing result marker); reason on stderr.
+# Environment: VM_TIMEOUT (seconds, default 300), VM_VCAN_COUNT (vcan
+#              interfaces, default 8), VM_MEMORY (MiB, default 512).
+set -Eeuo pipefail
+
+infra() {
+    trap - ERR
+    echo "vm: INFRASTRUCTURE FAILURE: $*" >&2
+    exit 2
+}
+trap 'infra "command failed (status $?) at tests/vm/run.sh:$LINENO: $BASH_COMMAND"' ERR
+
+say() { echo "vm: [${SECONDS}s] $*" >&2; }
+
+ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
+VM=$ROOT/target/vm
+TIMEOUT=${VM_TIMEOUT:-300}
+VCAN_COUNT=${VM_VCAN_COUNT:-8}
+MEMORY=${VM_MEMORY:-512}
+TRIPLE=x86_64-unknown-linux-gnu
+# The CAN modules the VM loads, in load order (vcan needs can-dev).
+REQUIRED_MODULES=(can can-raw can-dev vcan)
+OPTIONAL_MODULES=(can-bcm can-isotp)
+
+[[ $TIMEOUT =~ ^[0-9]+$ && $VCAN_COUNT =~ ^[0-9]+$ && $MEMORY =~ ^[0-9]+$ ]] ||
+    infra "VM_TIMEOUT, VM_VCAN_COUNT and VM_MEMORY must be whole numbers"
+[[ $(uname -m) == x86_64 ]] || infra "only x86_64 hosts are supported (this is $(uname -m))"
+mkdir -p "$VM"
+exec 9>"$VM/lock"
+flock 9 || infra "cannot lock $VM/lock"
+
+# ---------------------------------------------------------------- apt ---
+# A private apt configuration: the machine's own Debian sources plus the
+# <codename>-backports suite, with lists and downloads kept under target/vm.
+# qemu must come from -backports: the plain suite's qemu-system-x86
+# conflicts with the -backports qemu-utils some machines have.
+APT=$VM/apt
+CODENAME=
+APT_OPTS=()
+apt_setup() {
+    [[ ${#APT_OPTS[@]} -gt 0 ]] && return 0
+    local src=/etc/apt/sources.list.d/debian.sources
+    [[ -r $src ]] || infra "$src not found: cannot derive the Debian mirror"
+    CODENAME=$(. /etc/os-release && echo "${VERSION_CODENAME:-}")
+    [[ -n $CODENAME ]] || infra "no VERSION_CODENAME in /etc/os-release"
+    mkdir -p "$APT/lists/partial" "$APT/archives/partial" "$APT/parts.d" "$APT/deb"
+    # Add <codename>-backports to every stanza that carries <codename>.
+    awk -v c="$CODENAME" '
+        /^Suites:/ {
+            has = 0; bpo = 0
+            for (i = 2; i <= NF; i++) { if ($i == c) has = 1; if ($i == c "-backports") bpo = 1 }
+            if (has && !bpo) $0 = $0 " " c "-backports"
+        }
+        { print }' "$src" >"$APT/sources.sources"
+    grep -q "$CODENAME-backports" "$APT/sources.sources" ||
+        infra "no stanza for suite $CODENAME in $src"
+    APT_OPTS=(
+        -o "Dir::Etc::sourcelist=$APT/sources.sources"
+        -o "Dir::Etc::sourceparts=$APT/parts.d"
+        -o "Dir::State::lists=$APT/lists"
+        -o "Dir::Cache::archives=$APT/archives"
+        -o "Dir::Cache::pkgcache=" -o "Dir::Cache::srcpkgcache="
+        -o "APT::Sandbox::User=root"
+    )
+    say "apt-get update (private lists in $APT)"
+    apt-get "${APT_OPTS[@]}" -qq update >"$APT/update.log" 2>&1 ||
+        infra "apt-get update failed (see $APT/update.log)"
+}
+
+# Downloads package $1 (exact name) into $APT/deb and prints the file.
+apt_download() {
+    (cd "$APT/deb" && apt-get "${APT_OPTS[@]}" -qq download "$1" >"$APT/download.log" 2>&1) ||
+        infra "apt-get download $1 failed (see $APT/download.log)"
+    local deb
+    deb=$(ls -t "$APT/deb/$1"_*.deb 2>/dev/null | head -n 1)
+    [[ -n $deb ]] || infra "apt-get download $1 left no .deb in $APT/deb"
+    echo "$deb"
+}
+
+# ------------------------------------------------------- host tools ---
+# qemu is installed (only if missing, only from -backports, and only when
+# apt would neither remove nor upgrade a package); busybox-static and cpio
+# are only downloaded and unpacked under target/vm.
+TOOLS=$VM/tools
+host_tools() {
+    if ! command -v qemu-system-x86_64 >/dev/null; then
+        [[ $(id -u) -eq 0 ]] || infra "qemu-system-x86_64 is missing and installing it needs root"
+        apt_setup
+        local sim
+        sim=$(apt-get "${APT_OPTS[@]}" -s -t "$CODENAME-backports" --no-install-recommends \
+            install qemu-system-x86 2>&1) || infra "apt cannot install qemu-system-x86: $(tail -n 1 <<<"$sim")"
+        if grep -Eq '^(Remv|Inst [^ ]+ \[)' <<<"$sim"; then
+            grep -E '^(Remv|Inst [^ ]+ \[)' <<<"$sim" >&2
+            infra "installing qemu-system-x86 would remove or upgrade packages (listed above); refusing"
+        fi
+        say "installing qemu-system-x86 from $CODENAME-backports"
+        DEBIAN_FRONTEND=noninteractive apt-get "${APT_OPTS[@]}" -y -qq -t "$CODENAME-backports" \
+            --no-install-recommends install qemu-system-x86 >"$APT/install.log" 2>&1 ||
+            infra "apt-get install qemu-system-x86 failed (see $APT/install.log)"
+        command -v qemu-system-x86_64 >/dev/null || infra "qemu-system-x86_64 still missing after install"
+    fi
+    if [[ ! -x $TOOLS/busybox || ! -x $TOOLS/cpio ]]; then
+        apt_setup
+        rm -rf "$TOOLS.new" && mkdir -p "$TOOLS.new/x"
+        local deb
+        for pkg in busybox-static cpio; do
+            deb=$(apt_download "$pkg")
+            dpkg-deb -x "$deb" "$TOOLS.new/x" || infra "cannot unpack $deb"
+        done
+        cp "$TOOLS.new/x/bin/busybox" "$TOOLS.new/x/bin/cpio" "$TOOLS.new/" ||
+            infra "busybox-static or cpio lacks its binary"
+        rm -rf "$TOOLS.new/x" "$TOOLS" && mv "$TOOLS.new" "$TOOLS"
+    fi
+}
+
+# ----------------------------------------------------------- kernel ---
+# Debian's generic kernel (the -cloud- flavour has no CAN), downloaded and
+# unpacked, never installed: the uncompressed vmlinux and the CAN modules.
+KERNEL=$VM/kernel
+kernel() {
+    [[ -f $KERNEL/done ]] && return 0
+    apt_setup
+    local pkg deb
+    pkg=$(apt-cache "${APT_OPTS[@]}" depends linux-image-amd64 2>/dev/null |
+        awk '$1 == "Depends:" && $2 ~ /^linux-image-[0-9].*-amd64$/ { print $2; exit }')
+    [[ -n $pkg ]] || infra "cannot resolve linux-image-amd64 to a kernel package"
+    say "downloading $pkg"
+    deb=$(apt_download "$pkg")
+    rm -rf "$KERNEL" && mkdir -p "$KERNEL/x" "$KERNEL/modules"
+    dpkg-deb --fsys-tarfile "$deb" |
+        tar -x -C "$KERNEL/x" --wildcards './boot/vmlinuz-*' './boot/config-*' \
+            './lib/modules/*/kernel/net/can/*' './usr/lib/modules/*/kernel/net/can/*' \
+            './lib/modules/*/kernel/drivers/net/can/*' './usr/lib/modules/*/kernel/drivers/net/can/*' \
+            2>"$KERNEL/tar.log" || true
+    local vmlinuz
+    vmlinuz=$(ls "$KERNEL"/x/boot/vmlinuz-* 2>/dev/null | head -n 1)
+    [[ -n $vmlinuz ]] || infra "no /boot/vmlinuz-* in $deb (see $KERNEL/tar.log)"
+    for m in "${REQUIRED_MODULES[@]}" "${OPTIONAL_MODULES[@]}"; do
+        local f
+        f=$(find "$KERNEL/x" -name "$m.ko" -o -name "$m.ko.xz" | head -n 1)
+        case $f in
+        "") [[ " ${REQUIRED_MODULES[*]} " == *" $m "* ]] && infra "module $m.ko is not in $pkg" ;;
+        *.xz) xz -dc "$f" >"$KERNEL/modules/$m.ko" ;;
+        *) cp "$f" "$KERNEL/modules/$m.ko" ;;
+        esac
+    done
+    # The uncompressed kernel boots seconds faster: unpack the XZ stream.
+    local offset
+    offset=$(grep -abo -m 1 $'\xfd7zXZ\x00' "$vmlinuz" 2>/dev/null | head -n 1 | cut -d: -f1) || true
+    if [[ -n $offset ]] &&
+        { tail -c +$((offset + 1)) "$vmlinuz" || true; } | xz -dc --single-stream >"$KERNEL/vmlinux" 2>/dev/null &&
+        [[ $(head -c 4 "$KERNEL/vmlinux") == $'\x7fELF' ]]; then
+        :
+    else
+        say "cannot unpack vmlinux; booting the compressed kernel"
+        cp "$vmlinuz" "$KERNEL/vmlinux"
+    fi
+    echo "$pkg" >"$KERNEL/package"
+    rm -rf "$KERNEL/x"
+    touch "$KERNEL/done"
+}
+
+# ------------------------------------------------------------ tests ---
+# Static test binaries without a musl target: crt-static on the explicit
+# host triple (which keeps the flag off build scripts and proc macros).
+BUILD=$VM/cargo
+TESTBIN=$VM/tests
+EXBIN=$VM/examples
+build_tests() {
+    say "building static test binaries"
+    local json=$VM/cargo.json
+    # The dev profile without debug info: builds in half the time of
+    # release, and the binary stays small.
+    (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
+        CARGO_PROFILE_DEV_DEBUG=false cargo build --target "$TRIPLE" --target-dir "$BUILD" \
+        -p eds2rust-runtime --features socketcan --test socketcan_vcan \
+        --message-format=json-render-diagnostics >"$json") ||
+        infra "cargo build of the static test binaries failed"
+    # The seed-device examples, each run in the VM with its simulator on its
+    # own vcan interface: NMT, heartbeat, SDO, PDO (and LSS) over the kernel.
+    local exjson=$VM/cargo-examples.json
+    (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
+        CARGO_PROFILE_DEV_DEBUG=false cargo build --target "$TRIPLE" --target-dir "$BUILD" \
+        -p eds2rust-sim --example zimmer_acs --example linak_techline \
+        --example interroll_ec5000bi \
+        --message-format=json-render-diagnostics >"$exjson") ||
+        infra "cargo build of the static example binaries failed"
+    rm -rf "$EXBIN" && mkdir -p "$EXBIN"
+    while read -r exe; do
+        [[ -n $exe ]] || continue
+        file -b "$exe" | grep -q 'statically linked\|static-pie' ||
+            infra "$exe is not statically linked"
+        cp "$exe" "$EXBIN/"
+    done < <(grep '"reason":"compiler-artifact"' "$exjson" | grep '"kind":\["example"\]' |
+        sed -n 's/.*"executable":"\([^"]*\)".*/\1/p')
+    rm -rf "$TESTBIN" && mkdir -p "$TESTBIN"
+    local exe n=0
+    while read -r exe; do
+        [[ -n $exe ]] || continue
+        file -b "$exe" | grep -q 'statically linked\|static-pie' ||
+            infra "$exe is not statically linked"
+        cp "$exe" "$TESTBIN/$(basename "$exe" | sed 's/-[0-9a-f]*$//')"
+        n=$((n + 1))
+    done < <(grep '"reason":"compiler-artifact"' "$json" | grep '"test":true' |
+        sed -n 's/.*"executable":"\([^"]*\)".*/\1/p')
+    [[ $n -gt 0 ]] || infra "cargo built no test executable"
+}
+
+# -------------------------------------------------------- initramfs ---
+initramfs() {
+    local dir=$VM/initramfs
+    rm -rf "$dir" && mkdir -p "$dir"/{bin,sbin,usr/bin,usr/sbin,proc,sys,dev,tmp,lib/modules,tests}
+    cp "$TOOLS/busybox" "$dir/bin/busybox"
+    cp "$ROOT/tests/vm/init.sh" "$dir/init" && chmod 755 "$dir/init"
+    cp "$KERNEL"/modules/*.ko "$dir/lib/modules/"
+    cp "$TESTBIN"/* "$dir/tests/"
+    mkdir -p "$dir/examples" && cp "$EXBIN"/* "$dir/examples/"
+    {
+        echo "VCAN_COUNT=$VCAN_COUNT"
+        echo "REQUIRED_MODULES='${REQUIRED_MODULES[*]}'"
+        echo "OPTIONAL_MODULES='${OPTIONAL_MODULES[*]}'"
+    } >"$dir/vmtest.conf"
+    # Test arguments, one a line (ash has no arrays).
+    { echo --ignored; for a in "$@"; do echo "$a"; done; } >"$dir/vmtest.args"
+    (cd "$dir" && find . | LC_ALL=C sort | "$TOOLS/cpio" -o -H newc --quiet >"$VM/initramfs.cpio") ||
+        infra "cannot pack the initramfs"
+}
+
+# ------------------------------------------------------------- boot ---
+# Exit status of qemu with isa-debug-exit: (code << 1) | 1. The verdict is
+# the marker the VM writes to its second serial port (result.txt).
+boot() {
+    local result=$VM/result.txt console=$VM/console.log
+    rm -f "$result" "$console" "$VM/qemu.status"
+    say "booting $(cat "$KERNEL/package") (timeout ${TIMEOUT}s)"
+    {
+        local s=0
+        timeout -k 5 "$TIMEOUT" qemu-system-x86_64 -accel tcg -cpu max -m "$MEMORY" -smp 2 \
+            -nodefaults -no-user-config -display none -no-reboot -net none \
+            -kernel "$KERNEL/vmlinux" -initrd "$VM/initramfs.cpio" \
+            -append "console=ttyS0 panic=-1 quiet loglevel=3" \
+            -serial stdio -chardev "file,id=res,path=$result" -serial chardev:res \
+            -device isa-debug-exit,iobase=0xf4,iosize=0x04 </dev/null 2>"$VM/qemu.err" || s=$?
+        echo "$s" >"$VM/qemu.status"
+    } | tee "$console"
+    local status
+    status=$(cat "$VM/qemu.status")
+    if [[ $status -eq 124 || $status -eq 137 ]]; then
+        infra "the VM did not finish within ${TIMEOUT}s (VM_TIMEOUT); console in $console"
+    fi
+    local marker
+    marker=$(grep -a -m 1 -o 'VMTEST-[A-Z]*.*' "$result" 2>/dev/null | tr -d '\r') || true
+    case $marker in
+    "VMTEST-RESULT rc=0")
+        say "PASS: all tests passed in the VM"
+        exit 0
+        ;;
+    "VMTEST-RESULT rc="*)
+        echo "vm: TEST FAILURE: a test failed inside the VM ($marker); console in $console" >&2
+        exit 1
+        ;;
+    "VMTEST-SETUP-FAILED"*)
+        infra "VM setup failed: ${marker#VMTEST-SETUP-FAILED }"
+        ;;
+    *)
+        local why="qemu exited with status $status"
+        [[ -s $VM/qemu.err ]] && why="$why: $(head -n 1 "$VM/qemu.err")"
+        infra "no result marker from the VM (boot failure?); $why; console in $console"
+        ;;
+    esac
+}
+
+say "qemu-img before: $(qemu-img --version 2>/dev/null | head -n 1 || echo none)"
+host_tools
+kernel
+build_tests
+initramfs "$@"
+say "qemu-img after: $(qemu-img --version 2>/dev/null | head -n 1 || echo none)"
+boot
