@@ -35,6 +35,23 @@ for m in $OPTIONAL_MODULES; do
     [ -f "/lib/modules/$m.ko" ] && insmod "/lib/modules/$m.ko" 2>/dev/null
 done
 
+# Host folders shared read-only (virtio-9p) at their own paths: the python
+# venv and what it needs, for the python-canopen tests.
+if [ -n "$SHARES" ]; then
+    for m in $SHARE_MODULES; do
+        out=$(insmod "/lib/modules/$m.ko" 2>&1) || setup_failed "insmod $m: $out"
+    done
+    for share in $SHARES; do
+        tag=${share%%=*}
+        dir=${share#*=}
+        mkdir -p "$dir"
+        out=$(mount -t 9p -o trans=virtio,version=9p2000.L,ro,cache=loose,msize=262144 \
+            "$tag" "$dir" 2>&1) || setup_failed "mounting $tag at $dir: $out"
+    done
+    echo "vm: mounted $SHARES"
+fi
+export PYTHONDONTWRITEBYTECODE=1
+
 ip link set lo up
 ifaces=
 i=0

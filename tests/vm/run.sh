@@ -31,6 +31,9 @@ TRIPLE=x86_64-unknown-linux-gnu
 # The CAN modules the VM loads, in load order (vcan needs can-dev).
 REQUIRED_MODULES=(can can-raw can-dev vcan)
 OPTIONAL_MODULES=(can-bcm can-isotp)
+# virtio-9p, in load order: the host folders python-canopen runs from.
+SHARE_MODULES=(virtio_ring virtio virtio_pci_legacy_dev virtio_pci_modern_dev virtio_pci
+    9pnet 9pnet_virtio netfs fscache 9p)
 
 [[ $TIMEOUT =~ ^[0-9]+$ && $VCAN_COUNT =~ ^[0-9]+$ && $MEMORY =~ ^[0-9]+$ ]] ||
     infra "VM_TIMEOUT, VM_VCAN_COUNT and VM_MEMORY must be whole numbers"
@@ -128,7 +131,11 @@ host_tools() {
 # unpacked, never installed: the uncompressed vmlinux and the CAN modules.
 KERNEL=$VM/kernel
 kernel() {
-    [[ -f $KERNEL/done ]] && return 0
+    if [[ -f $KERNEL/done ]]; then
+        local have=1 m
+        for m in "${SHARE_MODULES[@]}"; do [[ -f $KERNEL/modules/$m.ko ]] || have=0; done
+        [[ $have -eq 1 ]] && return 0
+    fi
     apt_setup
     local pkg deb
     pkg=$(apt-cache "${APT_OPTS[@]}" depends linux-image-amd64 2>/dev/null |
@@ -141,15 +148,21 @@ kernel() {
         tar -x -C "$KERNEL/x" --wildcards './boot/vmlinuz-*' './boot/config-*' \
             './lib/modules/*/kernel/net/can/*' './usr/lib/modules/*/kernel/net/can/*' \
             './lib/modules/*/kernel/drivers/net/can/*' './usr/lib/modules/*/kernel/drivers/net/can/*' \
+            './lib/modules/*/kernel/drivers/virtio/*' './usr/lib/modules/*/kernel/drivers/virtio/*' \
+            './lib/modules/*/kernel/net/9p/*' './usr/lib/modules/*/kernel/net/9p/*' \
+            './lib/modules/*/kernel/fs/9p/*' './usr/lib/modules/*/kernel/fs/9p/*' \
+            './lib/modules/*/kernel/fs/netfs/*' './usr/lib/modules/*/kernel/fs/netfs/*' \
+            './lib/modules/*/kernel/fs/fscache/*' './usr/lib/modules/*/kernel/fs/fscache/*' \
             2>"$KERNEL/tar.log" || true
     local vmlinuz
     vmlinuz=$(ls "$KERNEL"/x/boot/vmlinuz-* 2>/dev/null | head -n 1)
     [[ -n $vmlinuz ]] || infra "no /boot/vmlinuz-* in $deb (see $KERNEL/tar.log)"
-    for m in "${REQUIRED_MODULES[@]}" "${OPTIONAL_MODULES[@]}"; do
+    for m in "${REQUIRED_MODULES[@]}" "${OPTIONAL_MODULES[@]}" "${SHARE_MODULES[@]}"; do
         local f
         f=$(find "$KERNEL/x" -name "$m.ko" -o -name "$m.ko.xz" | head -n 1)
         case $f in
-        "") [[ " ${REQUIRED_MODULES[*]} " == *" $m "* ]] && infra "module $m.ko is not in $pkg" ;;
+        "") [[ " ${REQUIRED_MODULES[*]} ${SHARE_MODULES[*]} " == *" $m "* ]] &&
+            infra "module $m.ko is not in $pkg" ;;
         *.xz) xz -dc "$f" >"$KERNEL/modules/$m.ko" ;;
         *) cp "$f" "$KERNEL/modules/$m.ko" ;;
         esac
@@ -183,9 +196,16 @@ build_tests() {
     # release, and the binary stays small.
     (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
         CARGO_PROFILE_DEV_DEBUG=false cargo build --target "$TRIPLE" --target-dir "$BUILD" \
-        -p eds2rust-runtime --features socketcan --test socketcan_vcan \
+        -p eds2rust-runtime --features socketcan,tokio --test socketcan_vcan \
         --message-format=json-render-diagnostics >"$json") ||
         infra "cargo build of the static test binaries failed"
+    # python-canopen against our runtime over vcan (tests/tests/vcan_python.rs).
+    local pyjson=$VM/cargo-python.json
+    (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
+        CARGO_PROFILE_DEV_DEBUG=false cargo build --target "$TRIPLE" --target-dir "$BUILD" \
+        -p eds2rust-tests --test vcan_python \
+        --message-format=json-render-diagnostics >"$pyjson") ||
+        infra "cargo build of the static python-canopen test binary failed"
     # The seed-device examples, each run in the VM with its simulator on its
     # own vcan interface: NMT, heartbeat, SDO, PDO (and LSS) over the kernel.
     local exjson=$VM/cargo-examples.json
@@ -211,9 +231,30 @@ build_tests() {
             infra "$exe is not statically linked"
         cp "$exe" "$TESTBIN/$(basename "$exe" | sed 's/-[0-9a-f]*$//')"
         n=$((n + 1))
-    done < <(grep '"reason":"compiler-artifact"' "$json" | grep '"test":true' |
+    done < <(cat "$json" "$pyjson" | grep '"reason":"compiler-artifact"' | grep '"test":true' |
         sed -n 's/.*"executable":"\([^"]*\)".*/\1/p')
     [[ $n -gt 0 ]] || infra "cargo built no test executable"
+}
+
+# ----------------------------------------------------------- shares ---
+# Host folders the VM mounts read-only at the same paths (virtio-9p), so
+# that python-canopen runs there from the host's venv: the test scripts,
+# the venv, the python it was made from and the system libraries.
+PYVENV=$ROOT/target/pyoracle
+SHARES=()
+shares() {
+    local py=$PYVENV/bin/python3 prefix libdir
+    if [[ ! -x $py ]] || ! prefix=$("$py" -c 'import sys; print(sys.base_prefix)' 2>/dev/null); then
+        say "WARNING: no python venv at $PYVENV (the python oracle tests create it);" \
+            "the python-canopen tests will fail in the VM"
+        return 0
+    fi
+    libdir=$(dirname "$(readlink -f /lib64/ld-linux-x86-64.so.2)")
+    local dir
+    for dir in "$ROOT/tests/python" "$PYVENV" "$prefix" "$libdir"; do
+        [[ -d $dir && $dir != *[[:space:]=,]* ]] || infra "cannot share $dir into the VM"
+        SHARES+=("$dir")
+    done
 }
 
 # -------------------------------------------------------- initramfs ---
@@ -223,12 +264,23 @@ initramfs() {
     cp "$TOOLS/busybox" "$dir/bin/busybox"
     cp "$ROOT/tests/vm/init.sh" "$dir/init" && chmod 755 "$dir/init"
     cp "$KERNEL"/modules/*.ko "$dir/lib/modules/"
+    # The dynamic loader and libraries of the shared python come from the
+    # host's library folder, mounted at its own path.
+    local libdir
+    libdir=$(dirname "$(readlink -f /lib64/ld-linux-x86-64.so.2)")
+    mkdir -p "$dir/lib64"
+    [[ $libdir == /lib/* ]] || ln -s "$libdir" "$dir/lib/$(basename "$libdir")"
+    ln -s "$libdir/ld-linux-x86-64.so.2" "$dir/lib64/ld-linux-x86-64.so.2"
     cp "$TESTBIN"/* "$dir/tests/"
     mkdir -p "$dir/examples" && cp "$EXBIN"/* "$dir/examples/"
     {
         echo "VCAN_COUNT=$VCAN_COUNT"
         echo "REQUIRED_MODULES='${REQUIRED_MODULES[*]}'"
         echo "OPTIONAL_MODULES='${OPTIONAL_MODULES[*]}'"
+        echo "SHARE_MODULES='${SHARE_MODULES[*]}'"
+        local i=0 list=
+        for d in "${SHARES[@]}"; do list="$list${list:+ }share$i=$d"; i=$((i + 1)); done
+        echo "SHARES='$list'"
     } >"$dir/vmtest.conf"
     # Test arguments, one a line (ash has no arrays).
     { echo --ignored; for a in "$@"; do echo "$a"; done; } >"$dir/vmtest.args"
@@ -243,6 +295,11 @@ boot() {
     local result=$VM/result.txt console=$VM/console.log
     rm -f "$result" "$console" "$VM/qemu.status"
     say "booting $(cat "$KERNEL/package") (timeout ${TIMEOUT}s)"
+    local virtfs=() i=0 d
+    for d in "${SHARES[@]}"; do
+        virtfs+=(-virtfs "local,path=$d,mount_tag=share$i,security_model=none,readonly=on")
+        i=$((i + 1))
+    done
     {
         local s=0
         timeout -k 5 "$TIMEOUT" qemu-system-x86_64 -accel tcg -cpu max -m "$MEMORY" -smp 2 \
@@ -250,7 +307,7 @@ boot() {
             -kernel "$KERNEL/vmlinux" -initrd "$VM/initramfs.cpio" \
             -append "console=ttyS0 panic=-1 quiet loglevel=3" \
             -serial stdio -chardev "file,id=res,path=$result" -serial chardev:res \
-            -device isa-debug-exit,iobase=0xf4,iosize=0x04 </dev/null 2>"$VM/qemu.err" || s=$?
+            -device isa-debug-exit,iobase=0xf4,iosize=0x04 "${virtfs[@]}" </dev/null 2>"$VM/qemu.err" || s=$?
         echo "$s" >"$VM/qemu.status"
     } | tee "$console"
     local status
@@ -284,6 +341,7 @@ say "qemu-img before: $(qemu-img --version 2>/dev/null | head -n 1 || echo none)
 host_tools
 kernel
 build_tests
+shares
 initramfs "$@"
 say "qemu-img after: $(qemu-img --version 2>/dev/null | head -n 1 || echo none)"
 boot
