@@ -18,6 +18,7 @@ use std::vec::Vec;
 use crate::od::{self, Entry};
 use crate::sdo::client::{self, ClientConfig, ClientEvent, Method};
 use crate::sdo::{AbortCode, SdoError};
+pub use crate::time::Deadline;
 use crate::transport::{Bus, Clock};
 use crate::{Instant, Service};
 
@@ -65,6 +66,10 @@ impl std::error::Error for DriveError {
 /// its events to `until`. Returns the value `until` breaks with, or
 /// [`DriveError::Deadline`] once `deadline` passes first.
 ///
+/// `deadline` is a point in time: an [`Instant`] of the cores
+/// (`clock.now() + Duration::from_millis(50)`), a `std::time::Instant` or
+/// [`Deadline::NEVER`] (see [`Deadline`]).
+///
 /// Events left in the service when `until` breaks stay there for the next
 /// call.
 pub fn drive<B, S, T>(
@@ -72,25 +77,30 @@ pub fn drive<B, S, T>(
     clock: &Clock,
     service: &mut S,
     mut until: impl FnMut(S::Event) -> ControlFlow<T>,
-    deadline: std::time::Instant,
+    deadline: impl Into<Deadline>,
 ) -> Result<T, DriveError>
 where
     B: Bus + ?Sized,
     S: Service + ?Sized,
 {
-    run(bus, clock, service, &mut until, Some(deadline), None)
+    let deadline = deadline.into().on(clock);
+    run(bus, clock, service, &mut until, deadline, None)
 }
 
 /// Runs `service` on `bus` (as [`drive`] does) until `stop` is set or
 /// `deadline` passes, handing every event to `on_event`. `stop` is checked
 /// at least every [`STOP_POLL`]. Returns `Ok(())` when stopped or past the
 /// deadline, the bus error otherwise.
+///
+/// `deadline` is a [`Deadline`]: an [`Instant`] of the cores, a
+/// `std::time::Instant`, or `None` / [`Deadline::NEVER`] to run until
+/// stopped (`Some(std::time::Instant)` is taken too).
 pub fn serve<B, S>(
     bus: &mut B,
     clock: &Clock,
     service: &mut S,
     stop: &AtomicBool,
-    deadline: Option<std::time::Instant>,
+    deadline: impl Into<Deadline>,
     mut on_event: impl FnMut(S::Event),
 ) -> io::Result<()>
 where
@@ -101,19 +111,20 @@ where
         on_event(event);
         ControlFlow::Continue(())
     };
+    let deadline = deadline.into().on(clock);
     match run(bus, clock, service, &mut until, deadline, Some(stop)) {
         Ok(()) | Err(DriveError::Deadline | DriveError::Stopped) => Ok(()),
         Err(DriveError::Io(e)) => Err(e),
     }
 }
 
-/// The loop behind [`drive`] and [`serve`].
+/// The loop behind [`drive`] and [`serve`], in the cores' time.
 fn run<B, S, T>(
     bus: &mut B,
     clock: &Clock,
     service: &mut S,
     until: &mut impl FnMut(S::Event) -> ControlFlow<T>,
-    deadline: Option<std::time::Instant>,
+    deadline: Option<Instant>,
     stop: Option<&AtomicBool>,
 ) -> Result<T, DriveError>
 where
@@ -132,31 +143,25 @@ where
         if stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
             return Err(DriveError::Stopped);
         }
-        let now = std::time::Instant::now();
+        let now = clock.now();
         if deadline.is_some_and(|deadline| now >= deadline) {
             return Err(DriveError::Deadline);
         }
         let timer = service.poll_timeout();
         if let Some(at) = timer
-            && at <= clock.at(now)
+            && at <= now
         {
-            service.handle_timeout(clock.at(now));
+            service.handle_timeout(now);
             continue;
         }
         let mut wake = now + IDLE_WAIT;
-        for limit in [deadline, timer.map(|at| clock.to_std(at))]
-            .into_iter()
-            .flatten()
-        {
+        for limit in [deadline, timer].into_iter().flatten() {
             wake = wake.min(limit);
         }
         if stop.is_some() {
             wake = wake.min(now + STOP_POLL);
         }
-        if let Some(frame) = bus
-            .recv(wake.saturating_duration_since(now))
-            .map_err(DriveError::Io)?
-        {
+        if let Some(frame) = bus.recv(wake - now).map_err(DriveError::Io)? {
             service.handle_frame(clock.now(), &frame);
         }
     }
@@ -386,8 +391,9 @@ impl<B: Bus> SdoClient<B> {
     }
 
     fn transfer(&mut self, index: u16, sub: u8, transfer: Transfer<'_>) -> Result<Vec<u8>, Error> {
-        transfer.start(&mut self.core, self.clock.now(), index, sub)?;
-        let deadline = deadline_after(transfer.bound(self.core.config()));
+        let now = self.clock.now();
+        transfer.start(&mut self.core, now, index, sub)?;
+        let deadline = now + transfer.bound(self.core.config());
         let until = |event| transfer_end(event, index, sub);
         match drive(&mut self.bus, &self.clock, &mut self.core, until, deadline) {
             Ok(result) => result,
@@ -481,14 +487,6 @@ impl<B: Bus> SdoClient<B> {
     {
         self.download(E::INDEX, E::SUBINDEX, data)
     }
-}
-
-/// `now + after`, or a point far in the future when that overflows.
-pub(crate) fn deadline_after(after: Duration) -> std::time::Instant {
-    let now = std::time::Instant::now();
-    now.checked_add(after)
-        .or_else(|| now.checked_add(Duration::from_secs(30 * 365 * 24 * 3600)))
-        .unwrap_or(now)
 }
 
 #[cfg(test)]

@@ -20,6 +20,9 @@
 //! Features: `std` (default) and `alloc` (SDO buffers); `tokio`,
 //! `socketcan` (Linux) and `embedded-can` for the transports.
 #![cfg_attr(not(test), no_std)]
+// No `unsafe` anywhere: the SocketCAN and embedded-can adapters use safe
+// crate APIs (`socketcan`, `embedded-can`), so nothing needs an exception.
+#![forbid(unsafe_code)]
 
 #[cfg(feature = "alloc")]
 extern crate alloc;
@@ -50,7 +53,7 @@ pub mod tokio;
 pub mod transport;
 
 pub use frame::{CanId, Frame};
-pub use time::Instant;
+pub use time::{Deadline, Instant};
 
 /// The interface every sans-IO protocol core offers (the style of
 /// quinn-proto): the caller feeds received frames and the current time, then

@@ -5,9 +5,11 @@
 //! access right live in the type system. The functions here are generic over
 //! those types, so that the compiler rejects a write to a read-only object
 //! ([`encode_value`] needs [`Write`]), a read of a write-only object
-//! ([`decode_value`] needs [`Read`]), a value of the wrong type and a
-//! non-mappable object in a PDO mapping ([`mapping_entry`] needs
-//! [`PdoMappable`]). Everything here needs only `core`.
+//! ([`decode_value`] needs [`Read`]), a value of the wrong type, a
+//! non-mappable object in a PDO mapping and an object mapped against its
+//! direction ([`rpdo_mapping_entry`] needs [`PdoMappable`] and a writable
+//! object, [`tpdo_mapping_entry`] a readable one). Everything here needs
+//! only `core`.
 
 use core::fmt;
 
@@ -109,13 +111,31 @@ pub mod access {
 }
 
 mod sealed {
+    use super::access::{Const, Ro, Rw, Rwr, Rww, Wo};
+
     pub trait Sealed {}
-    impl Sealed for super::access::Ro {}
-    impl Sealed for super::access::Wo {}
-    impl Sealed for super::access::Rw {}
-    impl Sealed for super::access::Rwr {}
-    impl Sealed for super::access::Rww {}
-    impl Sealed for super::access::Const {}
+    impl Sealed for Ro {}
+    impl Sealed for Wo {}
+    impl Sealed for Rw {}
+    impl Sealed for Rwr {}
+    impl Sealed for Rww {}
+    impl Sealed for Const {}
+
+    /// The access rights [`super::RpdoAccess`] is implemented for (no other
+    /// crate can add one).
+    pub trait RpdoSealed<E> {}
+    impl<E> RpdoSealed<E> for Wo {}
+    impl<E> RpdoSealed<E> for Rw {}
+    impl<E> RpdoSealed<E> for Rwr {}
+    impl<E> RpdoSealed<E> for Rww {}
+
+    /// The access rights [`super::TpdoAccess`] is implemented for.
+    pub trait TpdoSealed<E> {}
+    impl<E> TpdoSealed<E> for Ro {}
+    impl<E> TpdoSealed<E> for Rw {}
+    impl<E> TpdoSealed<E> for Rwr {}
+    impl<E> TpdoSealed<E> for Rww {}
+    impl<E> TpdoSealed<E> for Const {}
 }
 
 /// An access right as a type.
@@ -166,6 +186,43 @@ impl Write for access::Wo {}
 impl Write for access::Rw {}
 impl Write for access::Rwr {}
 impl Write for access::Rww {}
+
+/// Access rights of objects that may be mapped into an RPDO: the device
+/// receives an RPDO and writes its values into the mapped objects, so they
+/// must be writable (wo, rw, rwr, rww; not ro or const).
+///
+/// Implemented by the access types of [`access`]; `E` is the entry being
+/// mapped, there only so that the compiler's error names it.
+#[diagnostic::on_unimplemented(
+    message = "`{E}` is read-only and cannot be mapped into an RPDO (the device receives RPDOs and writes their values)",
+    label = "its access right `{Self}` does not allow writing",
+    note = "a read-only object can be mapped into a TPDO (`tpdo_mapping_entry`) or read over SDO"
+)]
+pub trait RpdoAccess<E>: Write + sealed::RpdoSealed<E> {}
+
+/// Access rights of objects that may be mapped into a TPDO: the device
+/// reads the mapped objects and transmits their values, so they must be
+/// readable (ro, const, rw, rwr, rww; not wo).
+///
+/// Implemented by the access types of [`access`]; `E` is the entry being
+/// mapped, there only so that the compiler's error names it.
+#[diagnostic::on_unimplemented(
+    message = "`{E}` is write-only and cannot be mapped into a TPDO (the device transmits TPDOs and reads their values)",
+    label = "its access right `{Self}` does not allow reading",
+    note = "a write-only object can be mapped into an RPDO (`rpdo_mapping_entry`) or written over SDO"
+)]
+pub trait TpdoAccess<E>: Read + sealed::TpdoSealed<E> {}
+
+impl<E> RpdoAccess<E> for access::Wo {}
+impl<E> RpdoAccess<E> for access::Rw {}
+impl<E> RpdoAccess<E> for access::Rwr {}
+impl<E> RpdoAccess<E> for access::Rww {}
+
+impl<E> TpdoAccess<E> for access::Ro {}
+impl<E> TpdoAccess<E> for access::Rw {}
+impl<E> TpdoAccess<E> for access::Rwr {}
+impl<E> TpdoAccess<E> for access::Rww {}
+impl<E> TpdoAccess<E> for access::Const {}
 
 /// One object-dictionary entry (a VAR, or one sub-entry of an ARRAY or
 /// RECORD), implemented by a generated zero-sized type.
@@ -382,9 +439,103 @@ where
     Ok(E::Value::from_raw(raw))
 }
 
+/// The mapping value of entry `E` in an RPDO (`index << 16 | subindex << 8
+/// | bits`), as written into an RPDO mapping parameter (0x1600 to 0x17FF).
+///
+/// Compiles only for a PDO-mappable, writable entry: the device writes the
+/// values of an RPDO it receives into the mapped objects, so a read-only or
+/// constant object has no place in one. Usable in constants:
+///
+/// ```
+/// use eds2rust_runtime::od::{DataType, Entry, PdoMappable, access};
+/// use eds2rust_runtime::od::{rpdo_mapping_entry, tpdo_mapping_entry};
+///
+/// // What generated code declares for CiA 402's controlword (rw) and
+/// // statusword (ro).
+/// struct Controlword;
+/// impl Entry for Controlword {
+///     const INDEX: u16 = 0x6040;
+///     const SUBINDEX: u8 = 0;
+///     const NAME: &'static str = "Controlword";
+///     const DATA_TYPE: DataType = DataType::Unsigned16;
+///     const PDO_MAPPABLE: bool = true;
+///     type Access = access::Rw;
+///     type Value = u16;
+/// }
+/// impl PdoMappable for Controlword {}
+/// struct Statusword;
+/// impl Entry for Statusword {
+///     const INDEX: u16 = 0x6041;
+///     const SUBINDEX: u8 = 0;
+///     const NAME: &'static str = "Statusword";
+///     const DATA_TYPE: DataType = DataType::Unsigned16;
+///     const PDO_MAPPABLE: bool = true;
+///     type Access = access::Ro;
+///     type Value = u16;
+/// }
+/// impl PdoMappable for Statusword {}
+///
+/// const RPDO1: [u32; 1] = [rpdo_mapping_entry::<Controlword>()];
+/// const TPDO1: [u32; 1] = [tpdo_mapping_entry::<Statusword>()];
+/// assert_eq!((RPDO1, TPDO1), ([0x6040_0010], [0x6041_0010]));
+/// ```
+///
+/// The statusword is read-only, so it does not go into an RPDO:
+///
+/// ```compile_fail,E0277
+/// # use eds2rust_runtime::od::{DataType, Entry, PdoMappable, access, rpdo_mapping_entry};
+/// # struct Statusword;
+/// # impl Entry for Statusword {
+/// #     const INDEX: u16 = 0x6041;
+/// #     const SUBINDEX: u8 = 0;
+/// #     const NAME: &'static str = "Statusword";
+/// #     const DATA_TYPE: DataType = DataType::Unsigned16;
+/// #     const PDO_MAPPABLE: bool = true;
+/// #     type Access = access::Ro;
+/// #     type Value = u16;
+/// # }
+/// # impl PdoMappable for Statusword {}
+/// const RPDO1: [u32; 1] = [rpdo_mapping_entry::<Statusword>()];
+/// ```
+pub const fn rpdo_mapping_entry<E>() -> u32
+where
+    E: PdoMappable,
+    E::Access: RpdoAccess<E>,
+{
+    mapping_value::<E>()
+}
+
+/// The mapping value of entry `E` in a TPDO (`index << 16 | subindex << 8 |
+/// bits`), as written into a TPDO mapping parameter (0x1A00 to 0x1BFF).
+///
+/// Compiles only for a PDO-mappable, readable entry: the device reads the
+/// mapped objects to fill a TPDO, so a write-only object has no place in
+/// one.
+pub const fn tpdo_mapping_entry<E>() -> u32
+where
+    E: PdoMappable,
+    E::Access: TpdoAccess<E>,
+{
+    mapping_value::<E>()
+}
+
 /// The PDO mapping value of an entry (`index << 16 | subindex << 8 | bits`),
-/// as written into a mapping parameter object (0x1600.., 0x1A00..).
+/// without a direction.
+///
+/// Deprecated: it lets a read-only object into an RPDO mapping and a
+/// write-only one into a TPDO mapping. Every mapping has a direction, so
+/// use [`rpdo_mapping_entry`] or [`tpdo_mapping_entry`], which check it
+/// (a read-write object passes both).
+#[deprecated(
+    since = "0.1.0",
+    note = "use `rpdo_mapping_entry` or `tpdo_mapping_entry`, which check that the object may be mapped in that direction"
+)]
 pub const fn mapping_entry<E: PdoMappable>() -> u32 {
+    mapping_value::<E>()
+}
+
+/// `index << 16 | subindex << 8 | bits` of `E` (bits 0 without a fixed size).
+const fn mapping_value<E: Entry>() -> u32 {
     let bits = match E::DATA_TYPE.size() {
         Some(bytes) => bytes as u32 * 8,
         None => 0,

@@ -2,7 +2,10 @@
 //! [`crate::blocking`] for an [`AsyncBus`].
 //!
 //! Time comes from `tokio::time::Instant` (mapped through a [`Clock`]), so
-//! the drivers follow tokio's paused clock in tests.
+//! the drivers follow tokio's paused clock in tests. Deadlines are
+//! [`Deadline`]s: an [`Instant`] of the cores (`now(&clock) +
+//! Duration::from_millis(50)`), a `tokio::time::Instant` or
+//! [`Deadline::NEVER`].
 
 use core::future::Future;
 use core::ops::ControlFlow;
@@ -11,14 +14,16 @@ use std::string::String;
 use std::vec::Vec;
 
 pub use crate::blocking::{DriveError, Error};
-use crate::blocking::{Transfer, deadline_after, encode, give_up, transfer_end, visible_string};
+use crate::blocking::{Transfer, encode, give_up, transfer_end, visible_string};
 use crate::od::{self, Entry};
 use crate::sdo::client::{self, ClientConfig, Method};
+pub use crate::time::Deadline;
 use crate::transport::{AsyncBus, Clock};
 use crate::{Instant, Service};
 
-/// The core's time now, from tokio's clock.
-fn core_now(clock: &Clock) -> Instant {
+/// The cores' time now on `clock`, read from tokio's clock (the paused
+/// clock in tests); `clock.now()` would read the std clock instead.
+pub fn now(clock: &Clock) -> Instant {
     clock.at(::tokio::time::Instant::now().into_std())
 }
 
@@ -32,23 +37,28 @@ pub fn clock() -> Clock {
 /// to `until`, and returns what `until` breaks with, or
 /// [`DriveError::Deadline`] once `deadline` passes first. Waits with
 /// `select!` on the bus and `tokio::time::sleep_until`.
+///
+/// `deadline` is a point in time: an [`Instant`] of the cores (`now(clock)
+/// + Duration::from_millis(50)`), a `tokio::time::Instant` or
+/// [`Deadline::NEVER`] (see [`Deadline`]).
 pub async fn drive<B, S, T>(
     bus: &mut B,
     clock: &Clock,
     service: &mut S,
     mut until: impl FnMut(S::Event) -> ControlFlow<T>,
-    deadline: ::tokio::time::Instant,
+    deadline: impl Into<Deadline>,
 ) -> Result<T, DriveError>
 where
     B: AsyncBus + ?Sized,
     S: Service + ?Sized,
 {
+    let deadline = deadline.into().on(clock);
     run(
         bus,
         clock,
         service,
         &mut until,
-        Some(deadline),
+        deadline,
         core::future::pending(),
     )
     .await
@@ -56,12 +66,16 @@ where
 
 /// Runs `service` on `bus` until `shutdown` completes or `deadline`
 /// passes, handing every event to `on_event` (the async [`crate::blocking::serve`]).
+///
+/// `deadline` is a [`Deadline`]: an [`Instant`] of the cores, a
+/// `tokio::time::Instant`, or `None` / [`Deadline::NEVER`] to run until
+/// shut down.
 pub async fn serve<B, S>(
     bus: &mut B,
     clock: &Clock,
     service: &mut S,
     shutdown: impl Future<Output = ()>,
-    deadline: Option<::tokio::time::Instant>,
+    deadline: impl Into<Deadline>,
     mut on_event: impl FnMut(S::Event),
 ) -> std::io::Result<()>
 where
@@ -72,19 +86,20 @@ where
         on_event(event);
         ControlFlow::Continue(())
     };
+    let deadline = deadline.into().on(clock);
     match run(bus, clock, service, &mut until, deadline, shutdown).await {
         Ok(()) | Err(DriveError::Deadline | DriveError::Stopped) => Ok(()),
         Err(DriveError::Io(e)) => Err(e),
     }
 }
 
-/// The loop behind [`drive`] and [`serve`].
+/// The loop behind [`drive`] and [`serve`], in the cores' time.
 async fn run<B, S, T>(
     bus: &mut B,
     clock: &Clock,
     service: &mut S,
     until: &mut impl FnMut(S::Event) -> ControlFlow<T>,
-    deadline: Option<::tokio::time::Instant>,
+    deadline: Option<Instant>,
     shutdown: impl Future<Output = ()>,
 ) -> Result<T, DriveError>
 where
@@ -101,22 +116,19 @@ where
                 return Ok(value);
             }
         }
-        let now = ::tokio::time::Instant::now();
-        if deadline.is_some_and(|deadline| now >= deadline) {
+        let current = now(clock);
+        if deadline.is_some_and(|deadline| current >= deadline) {
             return Err(DriveError::Deadline);
         }
         let timer = service.poll_timeout();
         if let Some(at) = timer
-            && at <= clock.at(now.into_std())
+            && at <= current
         {
-            service.handle_timeout(clock.at(now.into_std()));
+            service.handle_timeout(current);
             continue;
         }
-        let timer = timer.map(|at| ::tokio::time::Instant::from_std(clock.to_std(at)));
-        let wake = match (deadline, timer) {
-            (Some(a), Some(b)) => Some(a.min(b)),
-            (a, b) => a.or(b),
-        };
+        let wake = crate::time::earliest(deadline, timer)
+            .map(|at| ::tokio::time::Instant::from_std(clock.to_std(at)));
         let sleep = async {
             match wake {
                 Some(wake) => ::tokio::time::sleep_until(wake).await,
@@ -130,7 +142,7 @@ where
             () = &mut shutdown => return Err(DriveError::Stopped),
             received = bus.recv() => {
                 let frame = received.map_err(DriveError::Io)?;
-                service.handle_frame(core_now(clock), &frame);
+                service.handle_frame(now(clock), &frame);
             }
             () = sleep => {}
         }
@@ -187,11 +199,9 @@ impl<B: AsyncBus> SdoClient<B> {
         sub: u8,
         transfer: Transfer<'_>,
     ) -> Result<Vec<u8>, Error> {
-        transfer.start(&mut self.core, core_now(&self.clock), index, sub)?;
-        let bound = transfer.bound(self.core.config());
-        let deadline = ::tokio::time::Instant::now()
-            .checked_add(bound)
-            .unwrap_or_else(|| ::tokio::time::Instant::from_std(deadline_after(bound)));
+        let start = now(&self.clock);
+        transfer.start(&mut self.core, start, index, sub)?;
+        let deadline = start + transfer.bound(self.core.config());
         let until = |event| transfer_end(event, index, sub);
         match drive(&mut self.bus, &self.clock, &mut self.core, until, deadline).await {
             Ok(result) => result,
@@ -361,6 +371,61 @@ mod tests {
         // Paused time: the ticks come exactly on time.
         let expected: Vec<Instant> = (1..=5).map(|i| Instant::from_millis(10 * i)).collect();
         assert_eq!(ticks, expected);
+    }
+
+    #[::tokio::test(start_paused = true)]
+    async fn drive_and_serve_take_deadlines_in_the_cores_time() {
+        let bus = VirtualBus::new();
+        let mut port = bus.attach();
+        let clock = clock();
+        let mut core = ticker();
+        let mut ticks = Vec::new();
+        let deadline = now(&clock) + Duration::from_millis(55);
+        let result = drive(
+            &mut port,
+            &clock,
+            &mut core,
+            |event| {
+                if let Err(at) = event {
+                    ticks.push(at);
+                }
+                ControlFlow::<()>::Continue(())
+            },
+            deadline,
+        )
+        .await;
+        assert!(matches!(result, Err(DriveError::Deadline)));
+        // Paused time: the deadline is met exactly, after five ticks.
+        assert_eq!(now(&clock), deadline);
+        assert_eq!(ticks.len(), 5);
+
+        let mut seen = 0;
+        let deadline = now(&clock) + Duration::from_millis(30);
+        serve(
+            &mut port,
+            &clock,
+            &mut core,
+            core::future::pending(),
+            deadline,
+            |_| seen += 1,
+        )
+        .await
+        .unwrap();
+        assert_eq!(now(&clock), deadline);
+        // Ticks at 60, 70 and 80 ms.
+        assert_eq!(seen, 3);
+        // No deadline and a shutdown that has come: returns at once.
+        serve(
+            &mut port,
+            &clock,
+            &mut core,
+            async {},
+            Deadline::NEVER,
+            |_| {},
+        )
+        .await
+        .unwrap();
+        assert_eq!(now(&clock), deadline);
     }
 
     #[::tokio::test(start_paused = true)]

@@ -1,9 +1,9 @@
 // The correct counterparts of the compile-fail cases compile and behave.
 use eds2rust_drivers::example::od::ResetTripCounter;
 use eds2rust_drivers::linak_techline::od::{self, command, feedback};
-use eds2rust_drivers::runtime::od::{Entry, decode_value, encode_value, mapping_entry};
+use eds2rust_drivers::runtime::od::{Entry, decode_value, encode_value, tpdo_mapping_entry};
 
-const FEEDBACK_POSITION: u32 = mapping_entry::<feedback::Position>();
+const FEEDBACK_POSITION: u32 = tpdo_mapping_entry::<feedback::Position>();
 
 fn main() {
     assert_eq!(FEEDBACK_POSITION, 0x2001_0110);

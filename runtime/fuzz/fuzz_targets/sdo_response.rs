@@ -1,4 +1,5 @@
 #![no_main]
+#![forbid(unsafe_code)]
 
 #[path = "../../tests/fuzz_checks/mod.rs"]
 mod fuzz_checks;

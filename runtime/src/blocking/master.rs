@@ -13,8 +13,7 @@ mod lss;
 pub use lss::LssRequestError;
 
 use super::{
-    DriveError, Error, IDLE_WAIT, Transfer, deadline_after, encode, give_up, transfer_end,
-    visible_string,
+    DriveError, Error, IDLE_WAIT, Transfer, encode, give_up, transfer_end, visible_string,
 };
 use crate::master::{self, MasterEvent};
 use crate::nmt::NmtCommand;
@@ -22,6 +21,7 @@ use crate::od::{self, Entry, NodeId};
 use crate::pdo::PdoConfig;
 use crate::pdo::blocking::{PdoConfigError, SdoAccess, run_steps};
 use crate::sdo::client::Method;
+use crate::time::Deadline;
 use crate::transport::{Bus, Clock};
 use crate::{Instant, Service};
 
@@ -160,8 +160,8 @@ impl<B: Bus> Master<B> {
 
     /// Runs all cores for `duration`, queueing their events.
     pub fn run_for(&mut self, duration: Duration) -> io::Result<()> {
-        let deadline = deadline_after(duration);
-        match self.wait(deadline, &mut Err::<(), _>) {
+        let deadline = self.now() + duration;
+        match self.wait(Some(deadline), &mut Err::<(), _>) {
             Ok(()) | Err(DriveError::Deadline | DriveError::Stopped) => Ok(()),
             Err(DriveError::Io(e)) => Err(e),
         }
@@ -171,11 +171,16 @@ impl<B: Bus> Master<B> {
     /// passes ([`DriveError::Deadline`]). Queued events are offered first,
     /// oldest first. The event `until` breaks on is removed; the others
     /// stay queued.
+    ///
+    /// `deadline` is a point in time: an [`Instant`] of the cores
+    /// (`master.now() + Duration::from_millis(50)`), a `std::time::Instant`
+    /// or [`Deadline::NEVER`] (see [`Deadline`]).
     pub fn run_until<T>(
         &mut self,
-        deadline: std::time::Instant,
+        deadline: impl Into<Deadline>,
         mut until: impl FnMut(&MasterEvent) -> ControlFlow<T>,
     ) -> Result<T, DriveError> {
+        let deadline = deadline.into().on(&self.clock);
         for i in 0..self.queue.len() {
             let Some(event) = self.queue.get(i) else {
                 break;
@@ -197,7 +202,8 @@ impl<B: Bus> Master<B> {
         if let Some(event) = self.queue.pop_front() {
             return Ok(Some(event));
         }
-        match self.wait(deadline_after(timeout), &mut Ok) {
+        let deadline = self.now() + timeout;
+        match self.wait(Some(deadline), &mut Ok) {
             Ok(event) => Ok(Some(event)),
             Err(DriveError::Io(e)) => Err(e),
             Err(DriveError::Deadline | DriveError::Stopped) => Ok(None),
@@ -254,10 +260,11 @@ impl<B: Bus> Master<B> {
 
     /// The loop behind every call: runs the cores, handing each event to
     /// `until`, which takes it (`Ok`, the call is done) or gives it back
-    /// to be queued (`Err`).
+    /// to be queued (`Err`), until `deadline` (on the cores' clock; `None`:
+    /// none).
     fn wait<T>(
         &mut self,
-        deadline: std::time::Instant,
+        deadline: Option<Instant>,
         until: &mut dyn FnMut(MasterEvent) -> Result<T, MasterEvent>,
     ) -> Result<T, DriveError> {
         loop {
@@ -273,26 +280,22 @@ impl<B: Bus> Master<B> {
                     Err(event) => self.push(event),
                 }
             }
-            let now = std::time::Instant::now();
-            if now >= deadline {
+            let now = self.clock.now();
+            if deadline.is_some_and(|deadline| now >= deadline) {
                 return Err(DriveError::Deadline);
             }
             let timer = self.core.poll_timeout();
             if let Some(at) = timer
-                && at <= self.clock.at(now)
+                && at <= now
             {
-                self.core.handle_timeout(self.clock.at(now));
+                self.core.handle_timeout(now);
                 continue;
             }
-            let mut wake = deadline.min(now + IDLE_WAIT);
-            if let Some(at) = timer {
-                wake = wake.min(self.clock.to_std(at));
+            let mut wake = now + IDLE_WAIT;
+            for limit in [deadline, timer].into_iter().flatten() {
+                wake = wake.min(limit);
             }
-            if let Some(frame) = self
-                .bus
-                .recv(wake.saturating_duration_since(now))
-                .map_err(DriveError::Io)?
-            {
+            if let Some(frame) = self.bus.recv(wake - now).map_err(DriveError::Io)? {
                 self.core.handle_frame(self.clock.now(), &frame);
             }
         }
@@ -319,8 +322,8 @@ impl<B: Bus> Master<B> {
         let now = self.now();
         let client = self.core.sdo_or_default(node);
         transfer.start(client, now, index, sub)?;
-        let deadline = deadline_after(transfer.bound(client.config()));
-        let result = self.wait(deadline, &mut |event| match event {
+        let deadline = now + transfer.bound(client.config());
+        let result = self.wait(Some(deadline), &mut |event| match event {
             MasterEvent::Sdo(n, e) if n == node => match transfer_end(e.clone(), index, sub) {
                 ControlFlow::Break(result) => Ok(result),
                 ControlFlow::Continue(()) => Err(MasterEvent::Sdo(n, e)),
@@ -455,3 +458,6 @@ impl<B: Bus> SdoAccess for NodeSdo<'_, B> {
         self.master.upload(self.node, index, sub)
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -76,7 +76,8 @@ fn drive_sends_feeds_frames_and_stops_on_break() {
             PingEvent::Got(frame) => ControlFlow::Break(frame),
             PingEvent::Tick(_) => ControlFlow::Continue(()),
         },
-        deadline_after(Duration::from_secs(5)),
+        // A deadline in the cores' own time.
+        clock.now() + Duration::from_secs(5),
     )
     .unwrap();
     assert_eq!(got, frame(0x200, &[1]));
@@ -156,6 +157,48 @@ fn serve_ends_at_its_deadline() {
     serve(&mut port, &clock, &mut core, &stop, Some(deadline), |_| {}).unwrap();
     let took = start.elapsed();
     assert!(took >= Duration::from_millis(30) && took < Duration::from_secs(2));
+}
+
+#[test]
+fn drive_and_serve_take_deadlines_in_the_cores_time() {
+    let bus = VirtualBus::new();
+    let mut port = bus.attach();
+    let clock = Clock::new();
+    let mut core = Pinger::new(None, 0x200, Duration::from_millis(10));
+    let mut ticks = 0;
+    let deadline = clock.now() + Duration::from_millis(35);
+    let result = drive(
+        &mut port,
+        &clock,
+        &mut core,
+        |event| {
+            if let PingEvent::Tick(_) = event {
+                ticks += 1;
+            }
+            ControlFlow::<()>::Continue(())
+        },
+        deadline,
+    );
+    assert!(matches!(result, Err(DriveError::Deadline)));
+    assert!(clock.now() >= deadline);
+    assert!((1..=3).contains(&ticks), "{ticks}");
+
+    let stop = AtomicBool::new(false);
+    let deadline = clock.now() + Duration::from_millis(20);
+    serve(&mut port, &clock, &mut core, &stop, deadline, |_| {}).unwrap();
+    assert!(clock.now() >= deadline);
+    // Deadline::NEVER with the stop flag already set: returns at once.
+    stop.store(true, Ordering::Relaxed);
+    serve(&mut port, &clock, &mut core, &stop, Deadline::NEVER, |_| {}).unwrap();
+    // A deadline already passed ends the drive before it waits.
+    let result = drive(
+        &mut port,
+        &clock,
+        &mut core,
+        |_| ControlFlow::<()>::Continue(()),
+        Instant::ZERO,
+    );
+    assert!(matches!(result, Err(DriveError::Deadline)));
 }
 
 #[test]

@@ -8,7 +8,7 @@ use std::io;
 
 use super::Master;
 use crate::Instant;
-use crate::blocking::{DriveError, deadline_after};
+use crate::blocking::DriveError;
 use crate::lss::{
     ConfigureService, Identity, IdentityField, KnownIdentity, LssError, LssEvent, LssMaster,
     LssState,
@@ -97,7 +97,8 @@ impl<B: Bus> Master<B> {
             .timeout()
             .saturating_mul(LSS_STEPS)
             .saturating_add(Duration::from_secs(1));
-        let result = self.wait(deadline_after(bound), &mut |event| match event {
+        let deadline = now + bound;
+        let result = self.wait(Some(deadline), &mut |event| match event {
             MasterEvent::Lss(e) => Ok(e),
             other => Err(other),
         });
