@@ -6,9 +6,10 @@
 //! Without `--iface` everything runs on an in-process virtual bus
 //! ([`eds2rust_runtime::transport::virtual_bus`]): the
 //! master gets one port, the simulator another, the tracer a third. With
-//! `--iface NAME` the master opens the SocketCAN interface `NAME` (Linux);
-//! the simulator runs there too only with `--simulate` (for a vcan
-//! interface), otherwise the real device is expected on the bus.
+//! `--iface NAME` the master opens the SocketCAN interface `NAME` (Linux,
+//! feature `socketcan`; without it [`Harness::start`] returns an error that
+//! says so); the simulator runs there too only with `--simulate` (for a
+//! vcan interface), otherwise the real device is expected on the bus.
 
 use std::fmt;
 use std::io;
@@ -114,13 +115,16 @@ impl Args {
     }
 }
 
-/// The master's end of the bus.
+/// The master's end of the bus. Non-exhaustive: the `SocketCan` variant
+/// exists only with the feature `socketcan`, which another crate in the
+/// build may turn on.
 #[derive(Debug)]
+#[non_exhaustive]
 pub enum MasterPort {
     /// A port of the in-process virtual bus.
     Virtual(VirtualPort),
-    /// A SocketCAN socket (Linux).
-    #[cfg(target_os = "linux")]
+    /// A SocketCAN socket (Linux, feature `socketcan`).
+    #[cfg(all(feature = "socketcan", target_os = "linux"))]
     SocketCan(eds2rust_runtime::transport::socketcan::SocketCanBus),
 }
 
@@ -128,7 +132,7 @@ impl Bus for MasterPort {
     fn send(&mut self, frame: &Frame) -> io::Result<()> {
         match self {
             MasterPort::Virtual(p) => p.send(frame),
-            #[cfg(target_os = "linux")]
+            #[cfg(all(feature = "socketcan", target_os = "linux"))]
             MasterPort::SocketCan(s) => s.send(frame),
         }
     }
@@ -136,7 +140,7 @@ impl Bus for MasterPort {
     fn recv(&mut self, timeout: Duration) -> io::Result<Option<Frame>> {
         match self {
             MasterPort::Virtual(p) => p.recv(timeout),
-            #[cfg(target_os = "linux")]
+            #[cfg(all(feature = "socketcan", target_os = "linux"))]
             MasterPort::SocketCan(s) => s.recv(timeout),
         }
     }
@@ -166,6 +170,9 @@ pub struct Harness {
 impl Harness {
     /// Opens the bus and, when [`Args::simulates`], starts the device that
     /// `device` builds (given the power-on time) in a thread.
+    ///
+    /// `args.iface` needs the feature `socketcan` (and Linux); without it
+    /// this is an [`io::ErrorKind::Unsupported`] error naming the feature.
     pub fn start<B, F>(args: &Args, device: F) -> io::Result<Harness>
     where
         B: Behaviour + Send + 'static,
@@ -188,7 +195,7 @@ impl Harness {
                 harness.spawn_tracer(MasterPort::Virtual(bus.attach()), args.trace);
                 harness.spawn_device(MasterPort::Virtual(bus.attach()), device(clock.now()))?;
             }
-            #[cfg(target_os = "linux")]
+            #[cfg(all(feature = "socketcan", target_os = "linux"))]
             Some(name) => {
                 use eds2rust_runtime::transport::socketcan::SocketCanBus;
                 let open = |name: &str| {
@@ -203,11 +210,21 @@ impl Harness {
                         .spawn_device(MasterPort::SocketCan(open(name)?), device(clock.now()))?;
                 }
             }
-            #[cfg(not(target_os = "linux"))]
+            #[cfg(all(feature = "socketcan", not(target_os = "linux")))]
             Some(name) => {
                 return Err(io::Error::new(
                     io::ErrorKind::Unsupported,
                     format!("SocketCAN interface `{name}`: SocketCAN needs Linux"),
+                ));
+            }
+            #[cfg(not(feature = "socketcan"))]
+            Some(name) => {
+                return Err(io::Error::new(
+                    io::ErrorKind::Unsupported,
+                    format!(
+                        "SocketCAN interface `{name}`: this build has no SocketCAN support; \
+                         enable the feature `socketcan` of eds2rust-sim"
+                    ),
                 ));
             }
         }

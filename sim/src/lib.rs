@@ -10,16 +10,24 @@
 //!   an LSS slave (CiA 305). It is a sans-IO [`Service`](eds2rust_runtime::Service)
 //!   like the runtime's cores, so tests drive it on a virtual clock and
 //!   examples run it on a bus in a thread.
-//! - A [`Behaviour`] adds what the device does: [`models`] has the three
-//!   seed devices, written from their manuals.
-//! - [`harness`] runs a simulator and a master on the virtual bus (or on a
-//!   SocketCAN interface), with an optional candump-style trace.
+//! - A [`Behaviour`] adds what the device does: `models` (feature
+//!   `seed-models`) has the three seed devices, written from their manuals.
+//! - [`bench`](mod@bench) runs a master and a device in virtual time, for tests.
+//! - [`harness`] runs a simulator and a master on the virtual bus (or, with
+//!   the feature `socketcan`, on a SocketCAN interface), with an optional
+//!   candump-style trace.
+//!
+//! Without features the crate needs nothing but the runtime: a crate that
+//! simulates its own device passes its generated `od::OBJECTS` to
+//! [`Device::new`] (see docs/simulators.md).
+#![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
 pub mod behaviour;
 pub mod bench;
 pub mod device;
 pub mod harness;
+#[cfg(feature = "seed-models")]
 pub mod models;
 pub mod store;
 
