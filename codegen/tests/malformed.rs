@@ -27,7 +27,7 @@ fn malformed_fixtures() {
     for name in names {
         let bytes = std::fs::read(dir.join(&name)).expect("read fixture");
         let file = format!("tests/fixtures/malformed/{name}");
-        let loaded = read_bytes(&file, &bytes, Options::default());
+        let loaded = read_bytes(&file, &bytes, &Options::default());
         let d = &loaded.diagnostics;
         assert!(!d.is_empty(), "{name}: the defect is not reported");
         let stem = name.rsplit_once('.').map_or(name.as_str(), |(s, _)| s);
@@ -49,7 +49,7 @@ fn malformed_fixtures() {
         );
         insta::assert_snapshot!(stem, rendered);
         // Strict mode turns every warning into an error.
-        let strict = read_bytes(&file, &bytes, Options { strict: true });
+        let strict = read_bytes(&file, &bytes, &Options::strict());
         assert_eq!(
             strict.diagnostics.error_count(),
             d.len(),

@@ -3,6 +3,7 @@
 use super::ini::{Property, Section};
 use super::lower::Lowering;
 use super::number::{self, parse_value};
+use super::sections::{SectionKind, classify};
 use crate::diag::Severity;
 use crate::ir::{Access, DataType, Entry, Literal, ObjectKind, Origin, Value, ValueKind};
 
@@ -103,7 +104,7 @@ impl Lowering<'_> {
                 "rww" => Access::Rww,
                 "const" => Access::Const,
                 _ => {
-                    self.report(Severity::Error, "eds::bad-access", section, Some(p), format!("`{}` is not an access type (ro, wo, rw, rwr, rww, const); read as `ro`", p.value));
+                    self.unknown_access(index, sub, section, p);
                     Access::Ro
                 }
             },
@@ -184,6 +185,49 @@ impl Lowering<'_> {
         };
         self.check_limits(section, &entry);
         Some(entry)
+    }
+
+    /// An AccessType CiA 306 does not define: a warning, read as `ro` (see
+    /// docs/eds-reader.md), with the overlay that sets the right access.
+    fn unknown_access(&mut self, index: u16, sub: u8, section: &Section, p: &Property) {
+        let token = p.value.trim();
+        // python-canopen keeps the token and tests its letters: readable when
+        // it has an `r` (or is `const`), writable when it has a `w`.
+        let lower = token.to_ascii_lowercase();
+        let (readable, writable) = (lower.contains('r'), lower.contains('w'));
+        let python = match (readable, writable) {
+            (true, true) => "readable and writable",
+            (true, false) => "read-only",
+            (false, true) => "write-only",
+            (false, false) => "neither readable nor writable",
+        };
+        let example = if writable && !readable { "wo" } else { "rw" };
+        // The template of CompactSubObj entries is the object's own section.
+        let compact = sub != 0 && matches!(classify(section.name), SectionKind::Object(_));
+        self.report_with_notes(
+            Severity::Warning,
+            "eds::bad-access",
+            section,
+            Some(p),
+            format!(
+                "`{token}` is not an access type (ro, wo, rw, rwr, rww, const); read as `ro`"
+            ),
+            vec![
+                format!(
+                    "`ro` is the safe reading: no write to this entry compiles in the generated code \
+                     (python-canopen would take `{token}` as {python})"
+                ),
+                format!(
+                    "set the device's real access in a YAML overlay (docs/yaml-tables.md), e.g. \
+                     `modify: [{{ index: 0x{index:04X}, sub: {sub}, access: {example} }}]`{}",
+                    if compact {
+                        ", one item per sub-index of the CompactSubObj"
+                    } else {
+                        ""
+                    }
+                ),
+            ],
+        );
     }
 
     /// Reads a value of `data_type` from a property; a bad value is a warning and gives `None`.

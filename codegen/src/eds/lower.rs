@@ -2,15 +2,15 @@
 //!
 //! Policy: problems that leave the object's structure intact (a value that is
 //! not a number, a limit out of range, an object missing from the object
-//! lists) are warnings and the value is dropped or normalised; problems that
-//! leave an object without meaning (unknown ObjectType, missing DataType,
-//! unknown AccessType) are errors.
+//! lists, an AccessType CiA 306 does not define) are warnings and the value
+//! is dropped or normalised; problems that leave an object without meaning
+//! (unknown ObjectType, missing DataType) are errors.
 
 use std::collections::BTreeMap;
 
 use super::ini::{Document, Property, Section};
 use super::number;
-use super::sections::{SectionKind, classify};
+use super::sections::{SectionKind, classify, decimal_subs, hex_sub};
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
 use crate::ir::{
     Capabilities, Commissioning, DataType, Device, FileInfo, Identity, Object, Origin,
@@ -29,6 +29,19 @@ impl<'a> Lowering<'a> {
         section: &Section,
         prop: Option<&Property>,
         message: String,
+    ) {
+        self.report_with_notes(severity, code, section, prop, message, Vec::new());
+    }
+
+    /// [`Self::report`] with notes (what was done, what to write instead).
+    pub(super) fn report_with_notes(
+        &mut self,
+        severity: Severity,
+        code: &'static str,
+        section: &Section,
+        prop: Option<&Property>,
+        message: String,
+        notes: Vec<String>,
     ) {
         let location = match prop {
             Some(p) => Location {
@@ -50,7 +63,7 @@ impl<'a> Lowering<'a> {
             file: self.doc.file.clone(),
             location,
             message,
-            notes: Vec::new(),
+            notes,
         });
     }
 
@@ -295,11 +308,82 @@ impl<'a> Lowering<'a> {
         listed
     }
 
+    fn unknown_section(&mut self, section: &Section) {
+        self.warn(
+            "eds::unknown-section",
+            section,
+            None,
+            "not a CiA 306 section name (objects are 4 hex digits, sub-objects `XXXXsubY`); the section is ignored".into(),
+        );
+    }
+
+    /// The sub-index of each sub-section of object `index` (`written`: sub
+    /// numbers as written, in section order): hex (CiA 306), or decimal for
+    /// the whole object when [`decimal_subs`] says the names are decimal,
+    /// with one warning. A name that is no hex sub-index is an unknown
+    /// section.
+    fn sub_indices<'s>(
+        &mut self,
+        index: u16,
+        object: Option<&Section>,
+        written: &[(&str, &'s Section<'s>)],
+    ) -> Vec<(u8, &'s Section<'s>)> {
+        let digits: Vec<&str> = written.iter().map(|&(d, _)| d).collect();
+        let sub_number = object
+            .and_then(|o| o.get("SubNumber"))
+            .and_then(|p| number::parse_int(p.value).ok());
+        let decimal = object.and_then(|_| decimal_subs(&digits, sub_number));
+        let Some(decimal) = decimal else {
+            let mut subs = Vec::new();
+            for &(digits, section) in written {
+                match hex_sub(digits) {
+                    Some(sub) => subs.push((sub, section)),
+                    None => self.unknown_section(section),
+                }
+            }
+            return subs;
+        };
+        // The first name that is not a hex sub-index shows the rule.
+        let (shown, (digits, section)) = written
+            .iter()
+            .enumerate()
+            .find(|(_, (d, _))| hex_sub(d).is_none())
+            .map_or((0, written[0]), |(i, &w)| (i, w));
+        let sub = decimal[shown];
+        let name = section.name.trim();
+        let prefix = name
+            .get(..name.len().saturating_sub(digits.len()))
+            .unwrap_or(name);
+        let as_hex = format!("{prefix}{sub:X}");
+        let count = written.len();
+        self.report_with_notes(
+            Severity::Warning,
+            "eds::decimal-subindex",
+            section,
+            None,
+            format!(
+                "the sub-section names of object 0x{index:04X} are decimal (this is sub-index {sub} = 0x{sub:X}): all {count} are read as decimal"
+            ),
+            vec![
+                format!(
+                    "read as decimal because `{digits}` read as hex (CiA 306) is above 0xFF, no name of the object has a hex letter (a-f), and the {count} names are {count} distinct sub-indices, as SubNumber says"
+                ),
+                format!(
+                    "write the sub-index in hex: [{as_hex}] instead of [{name}], and so on for every name from sub10 up"
+                ),
+            ],
+        );
+        decimal
+            .into_iter()
+            .zip(written.iter().map(|&(_, s)| s))
+            .collect()
+    }
+
     fn objects(&mut self) -> BTreeMap<u16, Object> {
         let doc = self.doc;
         let listed = self.object_lists();
         let mut object_sections: BTreeMap<u16, &Section> = BTreeMap::new();
-        let mut subs: BTreeMap<u16, BTreeMap<u8, &Section>> = BTreeMap::new();
+        let mut written_subs: BTreeMap<u16, Vec<(&str, &Section)>> = BTreeMap::new();
         let mut names: BTreeMap<u16, &Section> = BTreeMap::new();
         let mut values: BTreeMap<u16, &Section> = BTreeMap::new();
         for section in &doc.sections {
@@ -307,8 +391,8 @@ impl<'a> Lowering<'a> {
                 SectionKind::Object(i) => {
                     object_sections.insert(i, section);
                 }
-                SectionKind::Sub(i, s) => {
-                    subs.entry(i).or_default().insert(s, section);
+                SectionKind::Sub(i, digits) => {
+                    written_subs.entry(i).or_default().push((digits, section));
                 }
                 SectionKind::CompactNames(i) => {
                     names.insert(i, section);
@@ -317,12 +401,15 @@ impl<'a> Lowering<'a> {
                     values.insert(i, section);
                 }
                 SectionKind::Known => {}
-                SectionKind::Unknown => self.warn(
-                    "eds::unknown-section",
-                    section,
-                    None,
-                    "not a CiA 306 section name (objects are 4 hex digits, sub-objects `XXXXsubY`); the section is ignored".into(),
-                ),
+                SectionKind::Unknown => self.unknown_section(section),
+            }
+        }
+        let mut subs: BTreeMap<u16, BTreeMap<u8, &Section>> = BTreeMap::new();
+        for (index, written) in written_subs {
+            let object = object_sections.get(&index).copied();
+            let subs = subs.entry(index).or_default();
+            for (sub, section) in self.sub_indices(index, object, &written) {
+                subs.insert(sub, section);
             }
         }
         for (&index, &(list, prop)) in &listed {

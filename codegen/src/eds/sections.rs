@@ -2,11 +2,12 @@
 
 /// The role of one `[section]`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum SectionKind {
+pub enum SectionKind<'a> {
     /// `[1018]`
     Object(u16),
-    /// `[1018sub2]`
-    Sub(u16, u8),
+    /// `[1018sub2]`: the sub number as written (one or more hex digits), read
+    /// by [`hex_sub`] or, for an object written in decimal, [`decimal_subs`].
+    Sub(u16, &'a str),
     /// `[1016Name]`: names of compact sub-objects.
     CompactNames(u16),
     /// `[1016Value]`: DCF values of compact sub-objects.
@@ -43,8 +44,9 @@ fn hex4(s: &str) -> Option<u16> {
 }
 
 /// Classifies a section name (as written; case does not matter).
-pub fn classify(name: &str) -> SectionKind {
-    let lower = name.trim().to_ascii_lowercase();
+pub fn classify(name: &str) -> SectionKind<'_> {
+    let name = name.trim();
+    let lower = name.to_ascii_lowercase();
     if let Some(index) = hex4(&lower) {
         return SectionKind::Object(index);
     }
@@ -54,8 +56,9 @@ pub fn classify(name: &str) -> SectionKind {
     {
         let rest = &lower[4..];
         if let Some(sub) = rest.strip_prefix("sub") {
-            if !sub.is_empty() && sub.len() <= 2 && sub.bytes().all(|b| b.is_ascii_hexdigit()) {
-                return SectionKind::Sub(index, u8::from_str_radix(sub, 16).unwrap_or(0));
+            if !sub.is_empty() && sub.bytes().all(|b| b.is_ascii_hexdigit()) {
+                // ASCII lowercasing keeps byte offsets: the digits as written.
+                return SectionKind::Sub(index, &name[name.len() - sub.len()..]);
             }
             return SectionKind::Unknown;
         }
@@ -79,6 +82,38 @@ pub fn classify(name: &str) -> SectionKind {
     }
 }
 
+/// The sub-index of a sub-section name by CiA 306: 1 or 2 hex digits.
+pub fn hex_sub(digits: &str) -> Option<u8> {
+    if digits.len() <= 2 {
+        u8::from_str_radix(digits, 16).ok()
+    } else {
+        None
+    }
+}
+
+/// The sub-indices of one object's sub-section names (`digits`, in section
+/// order) read as decimal, when the names are decimal beyond doubt: some
+/// name read as hex is above 0xFF, no name has a hex letter, and the
+/// decimal readings are distinct sub-indices (0–255) as many as `sub_number`
+/// (the object's SubNumber). `None` keeps the hex rule.
+pub fn decimal_subs(digits: &[&str], sub_number: Option<i128>) -> Option<Vec<u8>> {
+    let above_ff = |d: &str| u32::from_str_radix(d, 16).map_or(true, |v| v > 0xFF);
+    if !digits.iter().any(|d| above_ff(d))
+        || digits
+            .iter()
+            .any(|d| !d.bytes().all(|b| b.is_ascii_digit()))
+    {
+        return None;
+    }
+    let subs: Vec<u8> = digits
+        .iter()
+        .map(|d| d.parse::<u8>().ok())
+        .collect::<Option<_>>()?;
+    let distinct: std::collections::BTreeSet<u8> = subs.iter().copied().collect();
+    let count = i128::try_from(subs.len()).ok()?;
+    (distinct.len() == subs.len() && sub_number == Some(count)).then_some(subs)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -86,14 +121,38 @@ mod tests {
     #[test]
     fn names() {
         assert_eq!(classify("1018"), SectionKind::Object(0x1018));
-        assert_eq!(classify("1a00SUB1"), SectionKind::Sub(0x1A00, 1));
-        assert_eq!(classify("1016sub1F"), SectionKind::Sub(0x1016, 0x1F));
+        assert_eq!(classify("1a00SUB1"), SectionKind::Sub(0x1A00, "1"));
+        assert_eq!(classify("1016sub1F"), SectionKind::Sub(0x1016, "1F"));
+        assert_eq!(classify(" 2000sub100"), SectionKind::Sub(0x2000, "100"));
         assert_eq!(classify("1016Name"), SectionKind::CompactNames(0x1016));
         assert_eq!(classify("1016value"), SectionKind::CompactValues(0x1016));
         assert_eq!(classify("DeviceInfo"), SectionKind::Known);
         assert_eq!(classify("Tool3"), SectionKind::Known);
         assert_eq!(classify("10G0"), SectionKind::Unknown);
         assert_eq!(classify("10000"), SectionKind::Unknown);
-        assert_eq!(classify("1000sub123"), SectionKind::Unknown);
+        assert_eq!(classify("1000sub"), SectionKind::Unknown);
+        assert_eq!(classify("1000sub1g"), SectionKind::Unknown);
+    }
+
+    #[test]
+    fn sub_numbers() {
+        assert_eq!(hex_sub("1F"), Some(0x1F));
+        assert_eq!(hex_sub("100"), None);
+        assert_eq!(hex_sub("001"), None, "CiA 306: 1 or 2 digits");
+        let decimal: Vec<String> = (0..=100).map(|s| s.to_string()).collect();
+        let decimal: Vec<&str> = decimal.iter().map(String::as_str).collect();
+        assert_eq!(decimal_subs(&decimal, Some(101)), Some((0..=100).collect()));
+        assert_eq!(decimal_subs(&decimal, Some(100)), None, "SubNumber");
+        assert_eq!(decimal_subs(&decimal, None), None, "no SubNumber");
+        assert_eq!(decimal_subs(&["0", "1", "A", "100"], Some(4)), None);
+        assert_eq!(decimal_subs(&["0", "1", "2"], Some(3)), None, "all fit hex");
+        assert_eq!(decimal_subs(&["0", "256"], Some(2)), None, "above 255");
+        assert_eq!(decimal_subs(&["10", "010", "100"], Some(3)), None);
+        assert_eq!(
+            decimal_subs(&["0", "1", "99999999999"], Some(3)),
+            None,
+            "too long for either"
+        );
+        assert_eq!(decimal_subs(&["000", "255"], Some(2)), Some(vec![0, 255]));
     }
 }

@@ -20,7 +20,6 @@ pub(crate) fn bit_struct(
     state: Option<&Ident>,
 ) -> TokenStream {
     let s = &entry.semantics;
-    let ty = raw.tokens();
     let uty = raw.unsigned().tokens();
     let mut methods = Namespace::new(format!("impl `{name}`"), Case::Snake);
     for fixed in ["from_raw", "to_raw", "state"] {
@@ -114,9 +113,10 @@ pub(crate) fn bit_struct(
             " The named states of {} (masked patterns of the raw value).",
             docs::text(&entry.name)
         );
+        let derives = super::derives::attr(super::derives::MEANING, false);
         extra.extend(quote! {
             #[doc = #doc]
-            #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+            #derives
             pub enum #state { #(#defs,)* }
         });
         items.push(quote! {
@@ -133,22 +133,24 @@ pub(crate) fn bit_struct(
         layout.tokens()
     };
     let doc = value_doc(entry, "The bit fields");
-    struct_with(name, &ty, doc.tokens(), layout, &items, extra)
+    struct_with(name, raw, doc.tokens(), layout, &items, extra)
 }
 
 fn struct_with(
     name: &Ident,
-    ty: &TokenStream,
+    raw: Prim,
     doc: TokenStream,
     layout: TokenStream,
     items: &[TokenStream],
     extra: TokenStream,
 ) -> TokenStream {
-    let raw_methods = super::values::raw_methods(ty);
+    let ty = raw.tokens();
+    let raw_methods = super::values::raw_methods(&ty);
+    let derives = super::derives::value(raw);
     quote! {
         #doc
         #layout
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+        #derives
         pub struct #name(pub #ty);
         impl #name {
             #raw_methods

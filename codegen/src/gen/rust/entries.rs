@@ -230,9 +230,10 @@ fn entry_items(
     let fixed = Prim::of(entry.data_type).is_some();
     let mut out = TokenStream::new();
     let doc = entry_doc(object, entry, var).tokens_with_alias(source_name, &ident.to_string());
+    let derives = super::derives::attr(super::derives::ENTRY, false);
     out.extend(quote! {
         #doc
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+        #derives
         pub struct #ident;
         impl #rt::od::Entry for #ident {
             const INDEX: u16 = #index;

@@ -201,11 +201,7 @@ pub(crate) fn value_enum(
         from_arms.push(quote!(_ => Self::#fallback_ident(raw)));
     }
     let has_float = number_scaled && raw.is_float();
-    let derives = if has_float {
-        quote!(#[derive(Debug, Clone, Copy, PartialEq)])
-    } else {
-        quote!(#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)])
-    };
+    let derives = super::derives::attr(super::derives::MEANING, has_float);
     let doc = doc.tokens();
     let items = quote! {
         #doc
@@ -301,9 +297,10 @@ pub(crate) fn raw_newtype(
     let kind_doc =
         format!(" The meaning of the raw value (every raw value has one, see [`{kind}`]).");
     let raw_methods = super::values::raw_methods(&ty);
+    let derives = super::derives::value(raw);
     quote! {
         #doc
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        #derives
         pub struct #name(pub #ty);
         impl #name {
             #(#consts)*

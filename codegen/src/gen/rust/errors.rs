@@ -179,9 +179,11 @@ fn emit_table(
         _ => 8,
     };
     let raw_methods = super::values::raw_methods(&ty);
+    let meaning_derives = super::derives::attr(super::derives::MEANING, false);
+    let value_derives = super::derives::value(plan.raw);
     quote! {
         #doc
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        #meaning_derives
         pub enum #name {
             #(#defs,)*
             #[doc = " A code the table does not list."]
@@ -264,7 +266,7 @@ fn emit_table(
             }
         }
         #[doc = #code_doc]
-        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Default)]
+        #value_derives
         pub struct #code_name(pub #ty);
         impl #code_name {
             #raw_methods

@@ -10,12 +10,14 @@
 //! - `errors`: one enum per device error table ([`errors`]);
 //! - `pdo`: one struct per default PDO ([`pdo`]).
 //!
+//! Every kind of generated type derives one list of traits ([`derives`]).
 //! Every identifier comes from the naming table ([`naming`]); source text
 //! reaches the output only inside doc strings ([`docs`]). Items are emitted
 //! in index order and the file is formatted by prettyplease, so the same IR
 //! always gives the same bytes.
 
 mod bits;
+mod derives;
 mod docs;
 mod entries;
 mod enums;

@@ -416,11 +416,7 @@ fn emit_struct(
     } else {
         quote!(let bytes = word.to_le_bytes(); [#(bytes[#byte_idx],)*])
     };
-    let derives = if float {
-        quote!(#[derive(Debug, Clone, Copy, PartialEq)])
-    } else {
-        quote!(#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)])
-    };
+    let derives = super::derives::attr(super::derives::PDO, float);
     let cob_default = comm_default(1);
     let cob = cob_id_items(cob_default, rt);
     let default_cob_id = default_cob_id_fn(cob_default, rt);

@@ -81,11 +81,7 @@ pub(crate) fn scaled(
             String::new()
         }
     );
-    let derives = if raw.is_float() {
-        quote!(#[derive(Debug, Clone, Copy, PartialEq, PartialOrd, Default)])
-    } else {
-        quote!(#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)])
-    };
+    let derives = super::derives::value(raw);
     let from_value = if raw.is_float() {
         quote! {
             #[doc = " The raw value for a physical value (no rounding: the raw type is a float)."]
