@@ -2,12 +2,14 @@
 //! dictionaries, and generate their Rust.
 //!
 //! Exit status: 0 when no input has an error, 1 when one has, 2 on usage errors.
+#![forbid(unsafe_code)]
 
 use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use eds2rust::diag::Levels;
 use eds2rust::input::{Options, read_device};
 
 #[derive(Parser)]
@@ -25,9 +27,8 @@ struct Cli {
 enum Command {
     /// Reads each file and prints its diagnostics with the source lines.
     Check {
-        /// Turn warnings into errors.
-        #[arg(long)]
-        strict: bool,
+        #[command(flatten)]
+        read: ReadArgs,
         /// EDS/DCF files or YAML object tables (.yaml, .yml).
         #[arg(required = true)]
         files: Vec<PathBuf>,
@@ -39,9 +40,8 @@ enum Command {
         /// Resolve `$NODEID` formulas for this node id.
         #[arg(long, value_parser = clap::value_parser!(u8).range(1..=127))]
         node_id: Option<u8>,
-        /// Turn warnings into errors.
-        #[arg(long)]
-        strict: bool,
+        #[command(flatten)]
+        read: ReadArgs,
         file: PathBuf,
     },
     /// Writes the object dictionary of one file in another format (a YAML
@@ -55,9 +55,8 @@ enum Command {
         /// Write here instead of standard output (replaced only when complete).
         #[arg(long, short)]
         output: Option<PathBuf>,
-        /// Turn warnings into errors.
-        #[arg(long)]
-        strict: bool,
+        #[command(flatten)]
+        read: ReadArgs,
         file: PathBuf,
     },
     /// Prints the generated Rust of one device (or writes it with -o).
@@ -74,12 +73,50 @@ enum Command {
         /// Write here instead of standard output (replaced only when complete).
         #[arg(long, short)]
         output: Option<PathBuf>,
-        /// Turn warnings into errors.
-        #[arg(long)]
-        strict: bool,
+        #[command(flatten)]
+        read: ReadArgs,
         /// An EDS/DCF file or a YAML object table.
         file: PathBuf,
     },
+}
+
+/// How strictly to read, and the levels of single rules.
+#[derive(Args)]
+struct ReadArgs {
+    /// Turn warnings into errors (but those of allowed rules).
+    #[arg(long)]
+    strict: bool,
+    /// Drop the warnings of this rule (for example `eds::unlisted-object`);
+    /// may be given several times. Wins over a YAML table's `diagnostics:`.
+    #[arg(long, value_name = "CODE")]
+    allow: Vec<String>,
+    /// Make the warnings of this rule errors; may be given several times.
+    #[arg(long, value_name = "CODE")]
+    deny: Vec<String>,
+}
+
+impl ReadArgs {
+    /// The reading options, or the usage error of a code that names no rule.
+    fn options(&self) -> Result<Options, String> {
+        let mut levels = Levels::new();
+        for code in &self.allow {
+            levels.allow(code, "--allow");
+        }
+        for code in &self.deny {
+            levels.deny(code, "--deny");
+        }
+        if let Some((code, close)) = levels.unknown().into_iter().next() {
+            let mut message = format!("`{code}` is not a diagnostic rule");
+            if let Some(close) = close {
+                message.push_str(&format!("; did you mean `{close}`?"));
+            }
+            return Err(message);
+        }
+        Ok(Options {
+            strict: self.strict,
+            levels,
+        })
+    }
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -94,32 +131,40 @@ enum ExportFormat {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    let read = match &cli.command {
+        Command::Check { read, .. }
+        | Command::Dump { read, .. }
+        | Command::Export { read, .. }
+        | Command::Generate { read, .. } => read.options(),
+    };
+    let options = match read {
+        Ok(options) => options,
+        Err(message) => {
+            let _ = writeln!(std::io::stderr().lock(), "error: {message}");
+            return ExitCode::from(2);
+        }
+    };
     match cli.command {
-        Command::Check { strict, files } => check(&files, Options { strict }),
+        Command::Check { files, .. } => check(&files, &options),
         Command::Dump {
             format: Format::Json,
             node_id,
-            strict,
             file,
-        } => dump(&file, node_id, Options { strict }),
+            ..
+        } => dump(&file, node_id, &options),
         Command::Export {
             format: ExportFormat::Eds,
             variant,
             output,
-            strict,
             file,
-        } => export(
-            &file,
-            variant.as_deref(),
-            output.as_deref(),
-            Options { strict },
-        ),
+            ..
+        } => export(&file, variant.as_deref(), output.as_deref(), &options),
         Command::Generate {
             overlays,
             runtime_path,
             output,
-            strict,
             file,
+            ..
         } => generate(
             &file,
             &overlays,
@@ -127,13 +172,14 @@ fn main() -> ExitCode {
             &eds2rust::r#gen::rust::Options {
                 runtime_path: runtime_path
                     .unwrap_or_else(|| eds2rust::r#gen::rust::Options::default().runtime_path),
-                strict,
+                strict: options.strict,
             },
+            &options.levels,
         ),
     }
 }
 
-fn check(files: &[PathBuf], options: Options) -> ExitCode {
+fn check(files: &[PathBuf], options: &Options) -> ExitCode {
     let mut failed = false;
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
@@ -159,7 +205,7 @@ fn check(files: &[PathBuf], options: Options) -> ExitCode {
     }
 }
 
-fn dump(path: &std::path::Path, node_id: Option<u8>, options: Options) -> ExitCode {
+fn dump(path: &std::path::Path, node_id: Option<u8>, options: &Options) -> ExitCode {
     let loaded = read_device(path, options);
     let name = path.display().to_string();
     let json =
@@ -178,7 +224,7 @@ fn export(
     path: &std::path::Path,
     variant: Option<&str>,
     output: Option<&std::path::Path>,
-    options: Options,
+    options: &Options,
 ) -> ExitCode {
     let loaded = read_device(path, options);
     let d = &loaded.diagnostics;
@@ -214,14 +260,16 @@ fn generate(
     overlays: &[PathBuf],
     output: Option<&std::path::Path>,
     options: &eds2rust::r#gen::rust::Options,
+    levels: &Levels,
 ) -> ExitCode {
-    let generated = eds2rust::build::generate_device(path, overlays, options);
+    let generated = eds2rust::build::generate_device_with(path, overlays, options, levels);
     let code = match generated.result {
         Ok(out) => {
             let _ = write!(std::io::stderr().lock(), "{}", out.warnings.render());
             out.code
         }
-        Err(diagnostics) => {
+        Err(mut diagnostics) => {
+            diagnostics.errors_first();
             let mut err = std::io::stderr().lock();
             let _ = write!(err, "{}", diagnostics.render());
             let _ = writeln!(

@@ -52,6 +52,47 @@ fn check_exit_codes() {
     );
 }
 
+#[test]
+fn allow_and_deny_rules() {
+    let dir = tempdir();
+    let warn = dir.join("levels.eds");
+    std::fs::write(&warn, "[1000]\nParameterName=Device type\nDataType=0x0007\nAccessType=ro\nDefaultValue=017\nDefaultValue=0x10\n").unwrap();
+    let warn = warn.to_str().unwrap();
+    let (code, stdout, _) = run(&["check", warn]);
+    assert_eq!(code, 0, "{stdout}");
+    let mut rules: Vec<String> = stdout
+        .lines()
+        .filter_map(|l| Some(l.strip_prefix("warning[")?.split(']').next()?.to_string()))
+        .collect();
+    rules.sort();
+    rules.dedup();
+    assert!(!rules.is_empty(), "{stdout}");
+    let rule = rules[0].clone();
+    let mut allow_all: Vec<&str> = vec!["check"];
+    for r in &rules {
+        allow_all.extend(["--allow", r]);
+    }
+    allow_all.push(warn);
+    let (code, stdout, _) = run(&allow_all);
+    assert_eq!(code, 0);
+    assert!(stdout.contains("0 errors, 0 warnings"), "{stdout}");
+    // Allowed rules are spared by --strict.
+    allow_all.insert(1, "--strict");
+    assert_eq!(run(&allow_all).0, 0);
+
+    let (code, stdout, _) = run(&["check", "--deny", &rule, warn]);
+    assert_eq!(code, 1, "{stdout}");
+    assert!(stdout.contains(&format!("error[{rule}]")), "{stdout}");
+    assert!(stdout.contains("is denied by --deny"), "{stdout}");
+
+    let (code, _, stderr) = run(&["check", "--allow", "eds::duplicate-keys", warn]);
+    assert_eq!(code, 2, "an unknown rule is a usage error");
+    assert!(
+        stderr.contains("did you mean `eds::duplicate-key`?"),
+        "{stderr}"
+    );
+}
+
 fn tempdir() -> std::path::PathBuf {
     let dir = std::env::temp_dir().join(format!("eds2rust-cli-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();

@@ -52,7 +52,7 @@ fn malformed_yaml_fixtures() {
             "{name}: the first line says the defect"
         );
         let file = format!("tests/fixtures/malformed_yaml/{name}");
-        let loaded = read_bytes(&file, &bytes, base_dir, Options::default());
+        let loaded = read_bytes(&file, &bytes, base_dir, &Options::default());
         let d = &loaded.diagnostics;
         let stem = name.strip_suffix(".yaml").unwrap_or(&name);
         assert!(
@@ -85,7 +85,7 @@ fn malformed_yaml_fixtures() {
         );
         insta::assert_snapshot!(stem, rendered);
         // Strict mode turns every warning into an error.
-        let strict = read_bytes(&file, &bytes, base_dir, Options { strict: true });
+        let strict = read_bytes(&file, &bytes, base_dir, &Options::strict());
         assert_eq!(
             strict.diagnostics.error_count(),
             d.len(),

@@ -136,7 +136,14 @@ fn mutated_corpus_never_panics() {
             apply(&mut bytes, m);
         }
         for strict in [false, true] {
-            let loaded = read_bytes(name, &bytes, Options { strict });
+            let loaded = read_bytes(
+                name,
+                &bytes,
+                &Options {
+                    strict,
+                    ..Options::default()
+                },
+            );
             let rendered = loaded.diagnostics.render();
             prop_assert!(loaded.diagnostics.is_empty() || !rendered.is_empty());
             for d in loaded.diagnostics.iter() {

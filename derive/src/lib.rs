@@ -6,3 +6,4 @@
 //! bits) at compile time, with errors spanned on the offending field, and emits
 //! `encode`/`decode` plus the SDO writes that configure the mapping on the
 //! device. Nothing is implemented yet.
+#![forbid(unsafe_code)]

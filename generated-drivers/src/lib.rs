@@ -11,6 +11,7 @@
 //! - `errors`: the device error tables as enums with their texts;
 //! - `pdo`: one struct per default PDO with `encode`/`decode`.
 #![no_std]
+#![forbid(unsafe_code)]
 
 /// Zimmer ACS40/ACS60 compact axis (CiA 402), from `eds/zimmer_acs.yaml`.
 pub mod zimmer_acs {

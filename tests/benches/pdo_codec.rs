@@ -522,8 +522,8 @@ fn python(cases: &[Case]) -> (Vec<[f64; 2]>, String) {
         if exported.insert(c.meta.device) {
             let root = eds2rust_tests::workspace_root();
             let yaml = root.join(format!("eds/{}.yaml", c.meta.device));
-            let options = eds2rust::input::Options { strict: true };
-            let device = eds2rust::input::read_device(&yaml, options)
+            let options = eds2rust::input::Options::strict();
+            let device = eds2rust::input::read_device(&yaml, &options)
                 .device
                 .expect("seed device");
             std::fs::write(&eds, eds2rust::r#gen::to_eds(&device)).expect("write EDS");

@@ -12,7 +12,7 @@ use eds2rust::eds::{Options, read_file};
 fn eds2rust_pass(files: &[PathBuf]) -> usize {
     let mut entries = 0;
     for path in files {
-        let loaded = read_file(path, Options::default());
+        let loaded = read_file(path, &Options::default());
         entries += loaded.device.map_or(0, |d| {
             d.objects.values().map(|o| o.entries.len()).sum::<usize>()
         });

@@ -1,6 +1,7 @@
 //! Shared helpers of eds2rust's cross-crate tests: where the workspace, the
 //! shared corpus and the python-canopen oracle are, and the python-canopen
 //! peer process of the interop tests ([`peer`]).
+#![forbid(unsafe_code)]
 
 pub mod peer;
 pub mod python;

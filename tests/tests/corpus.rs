@@ -12,7 +12,7 @@ fn every_corpus_file_reads_without_error() {
     let mut failures = Vec::new();
     let (mut objects, mut entries) = (0, 0);
     for path in &files {
-        let loaded = read_file(path, Options::default());
+        let loaded = read_file(path, &Options::default());
         let device = loaded
             .device
             .as_ref()
@@ -76,7 +76,7 @@ fn corpus_identity_is_read() {
         .iter()
         .find(|p| p.ends_with("maxon_epos4-module-50-5.eds"))
         .expect("maxon file in corpus");
-    let device = read_file(maxon, Options::default()).device.unwrap();
+    let device = read_file(maxon, &Options::default()).device.unwrap();
     assert_eq!(device.identity.vendor_number, Some(0x000000FB));
     assert!(
         device

@@ -15,7 +15,7 @@ const DEVICES: &[&str] = &["zimmer_acs", "linak_techline", "interroll_ec5000bi"]
 
 fn load(name: &str) -> Device {
     let path = workspace_root().join(format!("eds/{name}.yaml"));
-    let loaded = read_device(&path, Options { strict: true });
+    let loaded = read_device(&path, &Options::strict());
     assert!(
         loaded.diagnostics.is_empty(),
         "{name}: {}",

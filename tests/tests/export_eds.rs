@@ -96,7 +96,7 @@ fn codes(diagnostics: &Diagnostics) -> BTreeMap<&'static str, usize> {
 
 /// Reads an export back with our reader.
 fn read_export(name: &str, text: &str) -> (Device, Diagnostics) {
-    let loaded = read_bytes(name, text.as_bytes(), Options::default());
+    let loaded = read_bytes(name, text.as_bytes(), &Options::default());
     let device = loaded
         .device
         .unwrap_or_else(|| panic!("{name}: the export does not read back"));
@@ -291,7 +291,7 @@ fn corpus_devices(files: &[PathBuf]) -> Vec<(String, Device)> {
     files
         .iter()
         .filter_map(|path| {
-            let device = read_file(path, Options::default()).device?;
+            let device = read_file(path, &Options::default()).device?;
             let name = path.file_name()?.to_string_lossy().into_owned();
             Some((name, device))
         })
@@ -330,7 +330,7 @@ fn corpus_round_trips_through_the_eds_export() {
     let mut new_diagnostics = Vec::new();
     let mut readback = BTreeMap::<&str, usize>::new();
     for ((name, _), path) in devices.iter().zip(&files) {
-        let original = codes(&read_file(path, Options::default()).diagnostics);
+        let original = codes(&read_file(path, &Options::default()).diagnostics);
         for (&code, &n) in &tally.readback_codes[name] {
             *readback.entry(code).or_default() += n;
             let before = original.get(code).copied().unwrap_or(0);
@@ -672,7 +672,7 @@ fn seed_device_exports_round_trip_and_load_in_python_canopen() {
         .iter()
         .map(|name| {
             let path = eds2rust_tests::workspace_root().join(format!("eds/{name}.yaml"));
-            let loaded = eds2rust::input::read_device(&path, Options { strict: true });
+            let loaded = eds2rust::input::read_device(&path, &Options::strict());
             assert!(
                 loaded.diagnostics.is_empty(),
                 "{}",

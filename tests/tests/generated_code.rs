@@ -89,10 +89,10 @@ fn generate_input(display: &str, path: &Path) -> Generated {
         std::fs::read(path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
     let options = ReadOptions::default();
     let loaded = match InputKind::of(path) {
-        InputKind::Eds => eds2rust::eds::read_bytes(display, &bytes, options),
+        InputKind::Eds => eds2rust::eds::read_bytes(display, &bytes, &options),
         InputKind::Table => {
             let dir = path.parent().expect("an input file has a parent directory");
-            eds2rust::table::read_bytes(display, &bytes, dir, options)
+            eds2rust::table::read_bytes(display, &bytes, dir, &options)
         }
     };
     let device = match loaded.device {
@@ -486,7 +486,7 @@ fn hostile_names_stay_in_string_literals() {
     let path = workspace_root().join(HOSTILE);
     let bytes =
         std::fs::read(&path).unwrap_or_else(|e| panic!("cannot read {}: {e}", path.display()));
-    let loaded = eds2rust::eds::read_bytes(HOSTILE, &bytes, ReadOptions::default());
+    let loaded = eds2rust::eds::read_bytes(HOSTILE, &bytes, &ReadOptions::default());
     assert!(
         !loaded.diagnostics.has_errors(),
         "the hostile fixture must read without errors:\n{}",

@@ -27,10 +27,8 @@ use serde_json::{Value, json};
 /// The EDS of a seed device, exported from its YAML table.
 fn export_eds(name: &str) -> PathBuf {
     let root = eds2rust_tests::workspace_root();
-    let loaded = eds2rust::input::read_device(
-        &root.join(format!("eds/{name}.yaml")),
-        Options { strict: true },
-    );
+    let loaded =
+        eds2rust::input::read_device(&root.join(format!("eds/{name}.yaml")), &Options::strict());
     assert!(
         loaded.diagnostics.is_empty(),
         "{}",

@@ -17,8 +17,8 @@ fn load() -> Option<(Device, Device)> {
     };
     let base_path = shared.join("eds-corpus/files/esacademy_cia402-stepper-node8.eds");
     let overlay_path = workspace_root().join("tests/overlays/cia402_stepper.yaml");
-    let base = read_device(&base_path, Options::default());
-    let overlay = read_device(&overlay_path, Options::default());
+    let base = read_device(&base_path, &Options::default());
+    let overlay = read_device(&overlay_path, &Options::default());
     assert!(
         !overlay.diagnostics.has_errors() && overlay.diagnostics.warning_count() == 0,
         "{}",

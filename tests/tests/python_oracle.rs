@@ -177,7 +177,7 @@ fn compare_file(path: &Path, python: &Value, tally: &mut Tally) {
             .push(format!("{name}: {}", python["error"]));
         return;
     }
-    let loaded = read_file(path, Options::default());
+    let loaded = read_file(path, &Options::default());
     let device = loaded.device.as_ref().expect("device");
     let ours = to_json(&name, Some(device), &loaded.diagnostics, Some(5));
     let bytes = std::fs::read(path).expect("read corpus file");

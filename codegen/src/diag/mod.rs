@@ -1,5 +1,11 @@
 //! Diagnostics: every problem found in an input, with file, line, section and
-//! key, rendered with the source line by codespan-reporting.
+//! key, rendered with the source line by codespan-reporting; the rules they
+//! belong to ([`rules`]) and the levels a user sets for them ([`levels`]).
+
+mod levels;
+pub mod rules;
+
+pub use levels::{Level, Levels};
 
 use std::fmt;
 use std::ops::Range;
@@ -84,6 +90,8 @@ impl fmt::Display for Diagnostic {
 pub struct Diagnostics {
     items: Vec<Diagnostic>,
     sources: Vec<(String, String)>,
+    /// Warnings dropped because their rule is allowed.
+    allowed: usize,
 }
 
 impl Diagnostics {
@@ -102,11 +110,24 @@ impl Diagnostics {
         self.items.push(diagnostic);
     }
 
+    /// Keeps only the diagnostics for which `keep` is true.
+    pub fn retain(&mut self, keep: impl FnMut(&Diagnostic) -> bool) {
+        self.items.retain(keep);
+    }
+
+    /// Adds a note to the diagnostic pushed last (none when empty).
+    pub fn add_note_to_last(&mut self, note: String) {
+        if let Some(last) = self.items.last_mut() {
+            last.notes.push(note);
+        }
+    }
+
     pub fn extend(&mut self, other: Diagnostics) {
         for (file, text) in &other.sources {
             self.add_source(file, text);
         }
         self.items.extend(other.items);
+        self.allowed += other.allowed;
     }
 
     pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
@@ -136,11 +157,22 @@ impl Diagnostics {
         self.items.len() - self.error_count()
     }
 
+    /// How many warnings were dropped because their rule is allowed
+    /// ([`Diagnostics::apply_levels`]).
+    pub fn allowed_count(&self) -> usize {
+        self.allowed
+    }
+
     /// Turns every warning into an error (`--strict`).
     pub fn make_strict(&mut self) {
         for d in &mut self.items {
             d.severity = Severity::Error;
         }
+    }
+
+    /// The errors first, then the warnings, each in their order before.
+    pub fn errors_first(&mut self) {
+        self.items.sort_by_key(|d| d.severity != Severity::Error);
     }
 
     /// Sorts by file, then line, keeping the order of diagnostics on one line.
@@ -151,6 +183,15 @@ impl Diagnostics {
 
     /// Renders every diagnostic with its source line, without colours.
     pub fn render(&self) -> String {
+        self.render_where(|_| true)
+    }
+
+    /// Renders the diagnostics of one severity, like [`render`](Self::render).
+    pub fn render_severity(&self, severity: Severity) -> String {
+        self.render_where(|d| d.severity == severity)
+    }
+
+    fn render_where(&self, keep: impl Fn(&Diagnostic) -> bool) -> String {
         let mut files = SimpleFiles::new();
         let ids: Vec<(String, usize)> = self
             .sources
@@ -159,7 +200,7 @@ impl Diagnostics {
             .collect();
         let config = term::Config::default();
         let mut out = String::new();
-        for d in &self.items {
+        for d in self.items.iter().filter(|d| keep(d)) {
             let id = ids
                 .iter()
                 .find(|(name, _)| *name == d.file)

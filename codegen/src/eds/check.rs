@@ -40,6 +40,7 @@ fn report_mapping_problem(
     problem: MappingProblem,
     diags: &mut Diagnostics,
 ) {
+    let fix = problem.fix(index, entry.subindex);
     let message = match problem {
         MappingProblem::DummyNotEnabled { .. } => {
             format!("mapping of 0x{index:04X} sub {}: {problem}", entry.subindex)
@@ -67,6 +68,6 @@ fn report_mapping_problem(
             key: prop.map(|p| p.key.to_string()),
         },
         message,
-        notes: Vec::new(),
+        notes: fix.into_iter().collect(),
     });
 }

@@ -15,20 +15,29 @@ use std::path::Path;
 
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
 
-pub use crate::input::{Loaded, Options};
+pub use crate::read::{Loaded, Options};
 
 /// Reads an EDS or DCF file from disk.
-pub fn read_file(path: &Path, options: Options) -> Loaded {
+pub fn read_file(path: &Path, options: &Options) -> Loaded {
+    read_file_unfinished(path).finish(options)
+}
+
+/// Reads EDS/DCF content; `file` names it in diagnostics and origins.
+pub fn read_bytes(file: &str, bytes: &[u8], options: &Options) -> Loaded {
+    read_bytes_unfinished(file, bytes).finish(options)
+}
+
+/// [`read_file`] before levels and strictness are applied.
+pub(crate) fn read_file_unfinished(path: &Path) -> Loaded {
     let name = path.display().to_string();
     match std::fs::read(path) {
-        Ok(bytes) => read_bytes(&name, &bytes, options),
+        Ok(bytes) => read_bytes_unfinished(&name, &bytes),
         Err(err) => Loaded::unreadable(name, &err),
     }
     .read_first(path)
 }
 
-/// Reads EDS/DCF content; `file` names it in diagnostics and origins.
-pub fn read_bytes(file: &str, bytes: &[u8], options: Options) -> Loaded {
+fn read_bytes_unfinished(file: &str, bytes: &[u8]) -> Loaded {
     let mut diagnostics = Diagnostics::new();
     let text = ini::decode(file, bytes, &mut diagnostics);
     diagnostics.add_source(file, &text);
@@ -53,13 +62,10 @@ pub fn read_bytes(file: &str, bytes: &[u8], options: Options) -> Loaded {
             notes: vec!["an object section is a 4-hex-digit index in brackets, e.g. [1000]".into()],
         });
     }
-    if options.strict {
-        diagnostics.make_strict();
-    }
-    diagnostics.sort();
     Loaded {
         device: Some(device),
         diagnostics,
         files: Vec::new(),
+        levels: crate::diag::Levels::new(),
     }
 }

@@ -483,7 +483,7 @@ mod tests {
         let out = to_eds(&device);
         assert!(out.contains("[2000sub1B]\nParameterName=Entry 27 second line\n"));
         assert!(out.contains("BaudRate_125=1\n") && !out.contains("333"));
-        let loaded = read_bytes("export.eds", out.as_bytes(), Options { strict: true });
+        let loaded = read_bytes("export.eds", out.as_bytes(), &Options::strict());
         assert!(
             loaded.diagnostics.is_empty(),
             "{:?}\n{out}",

@@ -127,6 +127,33 @@ impl fmt::Display for MappingProblem {
     }
 }
 
+impl MappingProblem {
+    /// How to fix the problem in a YAML overlay, when a fix is known: the
+    /// `modify:` of mapping entry `sub` of mapping object `mapping_index`
+    /// (or of the mapped object) that makes it consistent.
+    pub fn fix(&self, mapping_index: u16, sub: u8) -> Option<String> {
+        match self {
+            MappingProblem::WrongLength { target, bits, .. } => {
+                let fixed = MappedObject {
+                    bits: *bits,
+                    ..*target
+                };
+                Some(format!(
+                    "to map it with its type's length, write in a YAML overlay: \
+                     `modify: [{{ index: 0x{mapping_index:04X}, sub: {sub}, default: 0x{:08X} }}]`",
+                    fixed.raw()
+                ))
+            }
+            MappingProblem::NotMappable { target, .. } => Some(format!(
+                "if the device does map it, say so in a YAML overlay: \
+                 `modify: [{{ index: 0x{:04X}, sub: {}, pdo: true }}]`",
+                target.index, target.subindex
+            )),
+            _ => None,
+        }
+    }
+}
+
 /// The raw default (or DCF value) of a mapping entry, when it is a plain number.
 pub fn raw_mapping(entry: &super::Entry) -> Option<u32> {
     let literal = entry.parameter_value.as_ref().or(entry.default.as_ref())?;

@@ -12,18 +12,11 @@ use serde_saphyr::Spanned;
 
 use super::schema::{DeviceDef, Table};
 use super::{At, Base, Ctx};
-use crate::input::Options;
 use crate::ir::{Device, Identity};
 
 /// Lowers `table`; every file read on the way (a `base:` EDS) is appended
 /// to `files`.
-pub(super) fn lower(
-    ctx: &mut Ctx,
-    table: &Table,
-    base: Base,
-    options: Options,
-    files: &mut Vec<PathBuf>,
-) -> Device {
+pub(super) fn lower(ctx: &mut Ctx, table: &Table, base: Base, files: &mut Vec<PathBuf>) -> Device {
     if table.format.value != 1 {
         ctx.error(
             "table::format",
@@ -39,7 +32,7 @@ pub(super) fn lower(
     let has_base = table.base.is_some() || matches!(base, Base::Given(_));
     let mut device = match (base, &table.base) {
         (Base::Key(base_dir), Some(key)) => {
-            match read_base(ctx, key, base_dir, options, files) {
+            match read_base(ctx, key, base_dir, files) {
                 Some(device) => device,
                 // Every later stage would only repeat that the base is missing.
                 None => return Device::default(),
@@ -62,6 +55,12 @@ pub(super) fn lower(
             }
             *device
         }
+    };
+    // What the base's mappings got wrong was reported with the base.
+    let base_problems = if has_base {
+        super::pdo::mapping_problems(&device)
+    } else {
+        Default::default()
     };
     if let Some(def) = &table.device {
         apply_identity(ctx, &mut device.identity, def, true);
@@ -115,20 +114,37 @@ pub(super) fn lower(
     super::extra::variants(ctx, &mut device, &table.variants);
     super::meaning::check_error_table_references(ctx, &device);
     let written = super::pdo::written_mappings(&table.pdos);
-    super::pdo::check_mappings(ctx, &device, &written);
+    let changes = changed_objects(table);
+    super::pdo::check_mappings(ctx, &device, &written, &base_problems, &changes);
     device.fill_identity_from_1018();
     device
+}
+
+/// Where the table deletes, modifies or adds each object it touches (the
+/// first such place), by index.
+fn changed_objects(table: &Table) -> std::collections::BTreeMap<u16, At> {
+    let mut out = std::collections::BTreeMap::new();
+    for def in table
+        .delete
+        .iter()
+        .chain(&table.modify)
+        .chain(&table.objects)
+    {
+        if let Some(index) = &def.value.index {
+            out.entry(index.value).or_insert_with(|| At::of(def));
+        }
+    }
+    out
 }
 
 fn read_base(
     ctx: &mut Ctx,
     base: &Spanned<String>,
     base_dir: &Path,
-    options: Options,
     files: &mut Vec<PathBuf>,
 ) -> Option<Device> {
     let path = base_dir.join(&base.value);
-    let loaded = crate::eds::read_file(&path, options);
+    let loaded = crate::eds::read_file_unfinished(&path);
     files.extend(loaded.files);
     let failed = loaded.diagnostics.has_errors();
     ctx.diags.extend(loaded.diagnostics);

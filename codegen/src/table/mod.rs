@@ -8,6 +8,7 @@
 
 mod entry;
 mod extra;
+mod levels;
 mod lower;
 mod meaning;
 mod pdo;
@@ -18,17 +19,22 @@ use std::path::Path;
 use serde_saphyr::Spanned;
 
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
-use crate::input::{Loaded, Options};
 use crate::ir::Device;
+use crate::read::{Loaded, Options};
 
 /// Reads a YAML object table from disk. A `base:` EDS is read relative to
 /// the table's directory.
-pub fn read_file(path: &Path, options: Options) -> Loaded {
+pub fn read_file(path: &Path, options: &Options) -> Loaded {
+    read_file_unfinished(path).finish(options)
+}
+
+/// [`read_file`] before levels and strictness are applied.
+pub(crate) fn read_file_unfinished(path: &Path) -> Loaded {
     let name = path.display().to_string();
     match std::fs::read(path) {
         Ok(bytes) => {
             let dir = path.parent().unwrap_or(Path::new(""));
-            read_bytes(&name, &bytes, dir, options)
+            read_table(&name, &bytes, Base::Key(dir))
         }
         Err(err) => Loaded::unreadable(name, &err),
     }
@@ -37,8 +43,8 @@ pub fn read_file(path: &Path, options: Options) -> Loaded {
 
 /// Reads YAML table content; `file` names it in diagnostics and origins,
 /// `base_dir` is where a `base:` path is resolved.
-pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: Options) -> Loaded {
-    read_table(file, bytes, Base::Key(base_dir), options)
+pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: &Options) -> Loaded {
+    read_table(file, bytes, Base::Key(base_dir)).finish(options)
 }
 
 /// Reads the YAML overlay table at `path` and applies it on `base`, a device
@@ -50,10 +56,20 @@ pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: Options) -
 /// (`table::overlay-base`) at the `base` key, and that file is not read.
 /// The result's device is absent only when the overlay could not be read or
 /// parsed at all; [`Loaded::files`] lists the overlay.
-pub fn apply_overlay(base: Device, path: &Path, options: Options) -> Loaded {
+///
+/// The diagnostics are the overlay's own: those about the base device were
+/// reported when it was read, and the overlay leaves their severity alone
+/// (but for its own `diagnostics:` section, in [`Loaded::levels`], which the
+/// caller applies to the whole device).
+pub fn apply_overlay(base: Device, path: &Path, options: &Options) -> Loaded {
+    apply_overlay_unfinished(base, path).finish(options)
+}
+
+/// [`apply_overlay`] before levels and strictness are applied.
+pub(crate) fn apply_overlay_unfinished(base: Device, path: &Path) -> Loaded {
     let name = path.display().to_string();
     match std::fs::read(path) {
-        Ok(bytes) => read_table(&name, &bytes, Base::Given(Box::new(base)), options),
+        Ok(bytes) => read_table(&name, &bytes, Base::Given(Box::new(base))),
         Err(err) => Loaded::unreadable(name, &err),
     }
     .read_first(path)
@@ -68,8 +84,9 @@ pub(crate) enum Base<'a> {
     Given(Box<Device>),
 }
 
-fn read_table(file: &str, bytes: &[u8], base: Base, options: Options) -> Loaded {
+fn read_table(file: &str, bytes: &[u8], base: Base) -> Loaded {
     let mut files = Vec::new();
+    let mut levels = crate::diag::Levels::new();
     let mut diagnostics = Diagnostics::new();
     let text = match std::str::from_utf8(bytes) {
         Ok(text) => text.strip_prefix('\u{feff}').unwrap_or(text),
@@ -97,6 +114,7 @@ fn read_table(file: &str, bytes: &[u8], base: Base, options: Options) -> Loaded 
                 device: None,
                 diagnostics,
                 files,
+                levels,
             };
         }
     };
@@ -110,11 +128,17 @@ fn read_table(file: &str, bytes: &[u8], base: Base, options: Options) -> Loaded 
                 text,
                 diags: &mut diagnostics,
             };
-            Some(lower::lower(&mut ctx, &table, base, options, &mut files))
+            levels = levels::read(&mut ctx, table.diagnostics.as_ref());
+            Some(lower::lower(&mut ctx, &table, base, &mut files))
         }
         Err(err) => {
             let at = err.location().map(|l| At::from_location(&l));
             let message = first_line(&err.to_string());
+            let mut notes = Vec::new();
+            if let Some(suggestion) = levels::did_you_mean(&message) {
+                notes.push(suggestion);
+            }
+            notes.push("the table is read no further; see docs/yaml-tables.md".into());
             diagnostics.push(Diagnostic {
                 severity: Severity::Error,
                 code: "table::syntax",
@@ -126,19 +150,16 @@ fn read_table(file: &str, bytes: &[u8], base: Base, options: Options) -> Loaded 
                     key: None,
                 },
                 message,
-                notes: vec!["the table is read no further; see docs/yaml-tables.md".into()],
+                notes,
             });
             None
         }
     };
-    if options.strict {
-        diagnostics.make_strict();
-    }
-    diagnostics.sort();
     Loaded {
         device,
         diagnostics,
         files,
+        levels,
     }
 }
 
@@ -261,6 +282,11 @@ impl Ctx<'_> {
             message,
             notes: Vec::new(),
         });
+    }
+
+    /// Adds a note to the diagnostic reported last.
+    pub fn note(&mut self, note: String) {
+        self.diags.add_note_to_last(note);
     }
 
     pub fn error(&mut self, code: &'static str, at: At, place: &str, key: &str, message: String) {

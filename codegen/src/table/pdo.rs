@@ -456,7 +456,43 @@ fn map_item(
 
 /// Checks the mappings that `pdos` did not write (those given as plain
 /// objects, or kept from the base EDS of an overlay).
-pub(super) fn check_mappings(ctx: &mut Ctx, device: &Device, written: &BTreeSet<u16>) {
+/// The problems of every default mapping entry of `device` that `pdos`
+/// does not write, as (mapping index, sub, problem): taken of the base
+/// device before an overlay's stages, so that only what the overlay
+/// introduces is reported after them.
+pub(super) type MappingProblems = BTreeSet<(u16, u8, String)>;
+
+pub(super) fn mapping_problems(device: &Device) -> MappingProblems {
+    let mut out = BTreeSet::new();
+    for (&index, object) in &device.objects {
+        if !pdo::is_mapping_object(index) {
+            continue;
+        }
+        for entry in object.entries.values().filter(|e| e.subindex >= 1) {
+            if let Some(raw) = pdo::raw_mapping(entry) {
+                for problem in pdo::check_entry(device, raw) {
+                    out.insert((index, entry.subindex, problem.to_string()));
+                }
+            }
+        }
+    }
+    out
+}
+
+/// Checks every default mapping that `written` (the table's `pdos`) does
+/// not write; those are checked where they are written. `before` holds the
+/// problems the base device had already (reported, with their own
+/// severity, by the reader of the base file): they are not reported again.
+/// A new problem of a mapping entry that the table wrote is an error at
+/// that entry; one of a base mapping entry that the table's changes to the
+/// mapped object broke is an error at that change, naming the base entry.
+pub(super) fn check_mappings(
+    ctx: &mut Ctx,
+    device: &Device,
+    written: &BTreeSet<u16>,
+    before: &MappingProblems,
+    changes: &BTreeMap<u16, At>,
+) {
     for (&index, object) in &device.objects {
         if !pdo::is_mapping_object(index) || written.contains(&index) {
             continue;
@@ -466,19 +502,31 @@ pub(super) fn check_mappings(ctx: &mut Ctx, device: &Device, written: &BTreeSet<
                 continue;
             };
             for problem in pdo::check_entry(device, raw) {
-                let at = At::line(entry.origin.line);
+                let text = problem.to_string();
+                if before.contains(&(index, entry.subindex, text.clone())) {
+                    continue;
+                }
                 let here = place(index, Some(entry.subindex));
-                ctx.error(
-                    "table::pdo-mapping",
-                    at,
-                    &here,
-                    "default",
-                    problem.to_string(),
-                );
+                let target = MappedObject::from_raw(raw).index;
+                let (at, message) = if entry.origin.file == ctx.file {
+                    (At::line(entry.origin.line), text)
+                } else {
+                    // The entry is the base file's; this table changed what it maps.
+                    let at = changes.get(&target).copied().unwrap_or(At::line(0));
+                    let message = format!(
+                        "after this table's change to 0x{target:04X}, the mapping entry at {}:{} {text}",
+                        entry.origin.file, entry.origin.line
+                    );
+                    (at, message)
+                };
+                ctx.error("table::pdo-mapping", at, &here, "default", message);
+                if let Some(fix) = problem.fix(index, entry.subindex) {
+                    ctx.note(fix);
+                }
             }
         }
         let total = pdo::total_bits(device, index);
-        if total > 64 {
+        if total > 64 && !before.iter().any(|(i, _, _)| *i == index) {
             ctx.error(
                 "table::pdo-too-long",
                 At::line(object.origin.line),

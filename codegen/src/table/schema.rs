@@ -41,6 +41,19 @@ pub struct Table {
     pub errors: Vec<Spanned<ErrorTableDef>>,
     #[serde(default)]
     pub variants: Vec<Spanned<VariantDef>>,
+    /// Rule levels for this device: `allow:` and `deny:` lists of rule codes.
+    pub diagnostics: Option<Spanned<DiagnosticsDef>>,
+}
+
+/// The `diagnostics:` section: which rules to allow (their warnings are
+/// dropped) and which to deny (their warnings are errors), for this device.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DiagnosticsDef {
+    #[serde(default)]
+    pub allow: Vec<Text>,
+    #[serde(default)]
+    pub deny: Vec<Text>,
 }
 
 /// Identity and description of the device.

@@ -1,0 +1,30 @@
+//! The generated API as a user sees it: typed entries and PDO structs.
+
+use eds2rust_runtime::od::{Entry, NodeId, Pdo};
+use vendor_drive::drive::{od, pdo};
+
+#[test]
+fn typed_entries() {
+    assert_eq!(<od::Statusword as Entry>::INDEX, 0x6041);
+    assert_eq!(<od::Statusword as Entry>::SUBINDEX, 0);
+}
+
+#[test]
+fn tpdo1_decodes_statusword_mode_and_timestamp() {
+    let frame = [0x37, 0x02, 0x01, 0x78, 0x56, 0x34, 0x12];
+    let tpdo = pdo::Tpdo1::decode(&frame).unwrap();
+    assert_eq!(tpdo.statusword, 0x0237);
+    assert_eq!(tpdo.modes_of_operation_display, 1);
+    assert_eq!(tpdo.timestamp, 0x1234_5678);
+    assert_eq!(tpdo.encode(), frame);
+    assert!(pdo::Tpdo1::decode(&frame[..6]).is_err());
+    let node = NodeId::new(3).unwrap();
+    assert_eq!(pdo::Tpdo1::default_cob_id(node).unwrap() & 0x7FF, 0x183);
+}
+
+#[test]
+fn the_overlay_fix_gives_rpdo2_its_struct() {
+    // 0x2012 is mapped with its 64 bits now, so RPDO2 is generated.
+    assert_eq!(<pdo::Rpdo2 as Pdo>::LEN, 8);
+    assert_eq!(<pdo::Rpdo2 as Pdo>::MAPPING, [0x2012_0040]);
+}

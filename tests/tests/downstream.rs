@@ -1,0 +1,115 @@
+//! The crates under downstream/ are built and tested the way a user builds
+//! them: outside this workspace, with path dependencies on its crates and
+//! their own lock files (`--locked`), in a target directory of their own
+//! (`target/downstream`, shared by them).
+//!
+//! - downstream/sim-device: the generic simulator of a device of its own,
+//!   with no SocketCAN, tokio or seed drivers in its dependency graph;
+//! - downstream/vendor-drive: a vendor DCF of ../shared/eds-corpus with an
+//!   overlay and rule levels (not run without ../shared: it reads the DCF).
+
+use std::path::Path;
+use std::process::Command;
+
+use eds2rust_tests::{not_run, shared_dir, target_dir, workspace_root};
+
+/// Runs `cargo <args>` in the downstream crate `name`, failing with its
+/// output when it fails.
+fn cargo(name: &str, args: &[&str]) -> String {
+    let dir = workspace_root().join("downstream").join(name);
+    let target = target_dir().join("downstream");
+    let out = Command::new(env!("CARGO"))
+        .args(args)
+        .arg("--locked")
+        .current_dir(&dir)
+        .env("CARGO_TARGET_DIR", &target)
+        // The variables cargo sets for this test must not leak into the
+        // user's build.
+        .env_remove("RUSTFLAGS")
+        .env_remove("CARGO_ENCODED_RUSTFLAGS")
+        .env_remove("CARGO_MANIFEST_DIR")
+        .env_remove("CARGO_PKG_NAME")
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run cargo in {}: {e}", dir.display()));
+    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success(),
+        "`cargo {}` in {} failed:\n{stdout}\n{stderr}",
+        args.join(" "),
+        dir.display()
+    );
+    stdout + &stderr
+}
+
+/// Its own tests include the check of its dependency graph
+/// (downstream/sim-device/tests/lean_build.rs).
+#[test]
+fn sim_device_builds_and_runs_with_a_lean_graph() {
+    let dir = workspace_root().join("downstream/sim-device");
+    assert!(dir.join("Cargo.lock").is_file(), "a lock file of its own");
+    let output = cargo("sim-device", &["test"]);
+    assert!(output.contains("test result: ok"), "{output}");
+    assert!(!output.contains("test result: FAILED"), "{output}");
+}
+
+#[test]
+fn vendor_drive_builds_from_its_dcf_without_warnings() {
+    if shared_dir().is_none() {
+        not_run("downstream/vendor-drive: ../shared/eds-corpus is not beside this checkout");
+        return;
+    }
+    assert!(Path::new(&workspace_root().join("downstream/vendor-drive/Cargo.lock")).is_file());
+    let output = cargo("vendor-drive", &["test"]);
+    assert!(output.contains("test result: ok"), "{output}");
+    assert!(
+        !output.contains("warning: vendor-drive"),
+        "the overlay fixes and allows what the DCF warns about:\n{output}"
+    );
+    // The build dependency stays light: no command-line parser, one syn.
+    let build = cargo(
+        "vendor-drive",
+        &["tree", "-e", "normal,build", "--prefix", "none"],
+    );
+    for cli in [
+        "clap ",
+        "clap_builder ",
+        "clap_lex ",
+        "anstream ",
+        "colorchoice ",
+    ] {
+        assert!(
+            !build.lines().any(|l| l.starts_with(cli)),
+            "{cli}in:\n{build}"
+        );
+    }
+    let mut syn: Vec<&str> = build
+        .lines()
+        .filter(|l| l.starts_with("syn v"))
+        .map(|l| l.split('.').next().unwrap_or(l))
+        .collect();
+    syn.sort();
+    syn.dedup();
+    assert_eq!(syn.len(), 1, "one syn major: {syn:?}");
+    // What `[build-dependencies] eds2rust` compiles, itself not counted.
+    let library = cargo(
+        "vendor-drive",
+        &[
+            "tree",
+            "-p",
+            "eds2rust",
+            "-e",
+            "normal,build",
+            "--prefix",
+            "none",
+        ],
+    );
+    let mut crates: Vec<&str> = library
+        .lines()
+        .filter(|l| l.contains(" v") && !l.starts_with("eds2rust v"))
+        .map(|l| l.split(" (").next().unwrap_or(l))
+        .collect();
+    crates.sort();
+    crates.dedup();
+    assert!(crates.len() <= 32, "{} crates: {crates:?}", crates.len());
+}
