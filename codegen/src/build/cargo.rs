@@ -107,21 +107,27 @@ fn folded(code: &str, items: &[&Diagnostic], full_list: Option<&Path>) -> String
         .iter()
         .find(|r| r.code == code)
         .map_or(String::new(), |r| format!(" ({})", r.summary));
-    let locations: Vec<String> = items
+    let first = items[0];
+    let location = |d: &Diagnostic| match d.location.line {
+        Some(line) => format!("{}:{line}", d.file),
+        None => d.file.clone(),
+    };
+    // The other first locations: by line in the first's file, else by file too.
+    let others: Vec<String> = items[1..]
         .iter()
-        .take(FIRST_LOCATIONS)
+        .take(FIRST_LOCATIONS - 1)
         .map(|d| match d.location.line {
-            Some(line) => format!("{}:{line}", d.file),
-            None => d.file.clone(),
+            Some(line) if d.file == first.file => format!("line {line}"),
+            _ => location(d),
         })
         .collect();
     let more = items.len().saturating_sub(FIRST_LOCATIONS);
     let mut s = format!(
-        "{} warnings[{code}]{summary}, first: {}: {}; at {}",
+        "{} warnings[{code}]{summary}: {}: {}; also at {}",
         items.len(),
-        locations[0],
-        items[0].headline(),
-        locations.join(", ")
+        location(first),
+        first.headline(),
+        others.join(", ")
     );
     if more > 0 {
         s.push_str(&format!(" and {more} more"));
@@ -193,9 +199,8 @@ mod tests {
         assert_eq!(
             lines[1],
             "cargo:warning=5 warnings[eds::unlisted-object] (an object section not named in any \
-             object list), first: a.eds:10: not listed; at a.eds:10, a.eds:20, a.eds:30 and 2 \
-             more; all of them in /out/eds2rust-warnings.txt; to silence: \
-             .allow(\"eds::unlisted-object\")"
+             object list): a.eds:10: not listed; also at line 20, line 30 and 2 more; all of \
+             them in /out/eds2rust-warnings.txt; to silence: .allow(\"eds::unlisted-object\")"
         );
     }
 
