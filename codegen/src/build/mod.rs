@@ -41,6 +41,7 @@ use crate::diag::{Diagnostic, Diagnostics, Levels, Location, Severity};
 use crate::r#gen::rust::{self, Options, Output};
 use crate::input::{InputKind, read_unfinished};
 use crate::ir::Device;
+use crate::read::Loaded;
 
 pub use builder::{Builder, Report, WARNINGS_FILE};
 pub use cargo::{cargo_lines, error_lines, in_build_script};
@@ -126,6 +127,25 @@ pub fn generate_device_with(
     Generated {
         result,
         files: loaded.files,
+    }
+}
+
+/// Reads `input` and applies the YAML `overlays` in order, exactly as
+/// [`generate_device_with`] does, but generates nothing: the device after
+/// every overlay (absent when a stage failed to give one), every diagnostic
+/// with the files' `diagnostics:` levels, `options.levels` over them and
+/// `options.strict` applied, the files read and the merged file levels. For
+/// tools that work on the loaded IR (`eds2rust diff`).
+pub fn load_device(input: &Path, overlays: &[PathBuf], options: &crate::read::Options) -> Loaded {
+    let loaded = load(input, overlays);
+    let mut diagnostics = loaded.diagnostics;
+    diagnostics.apply_levels(&loaded.levels.merged(&options.levels), options.strict);
+    diagnostics.sort();
+    Loaded {
+        device: loaded.device,
+        diagnostics,
+        files: loaded.files,
+        levels: loaded.levels,
     }
 }
 

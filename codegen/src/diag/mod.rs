@@ -1,6 +1,6 @@
 //! Diagnostics: every problem found in an input, with file, line, section and
 //! key, rendered with the source line by codespan-reporting; the rules they
-//! belong to ([`rules`]) and the levels a user sets for them ([`levels`]).
+//! belong to ([`rules`]) and the levels a user sets for them ([`Levels`]).
 
 mod levels;
 pub mod rules;

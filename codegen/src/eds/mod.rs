@@ -1,7 +1,7 @@
-//! The EDS/DCF reader (CiA 306): bytes → [`ini::Document`] → [`ir::Device`].
+//! The EDS/DCF reader (CiA 306): bytes → [`ini::Document`] → [`ir::Device`](crate::ir::Device).
 //!
 //! [`read_file`] and [`read_bytes`] never panic on any input; every problem is
-//! a [`Diagnostic`](crate::diag::Diagnostic) naming file, line, section and key.
+//! a [`Diagnostic`] naming file, line, section and key.
 
 mod check;
 mod entry;

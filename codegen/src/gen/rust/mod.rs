@@ -4,15 +4,15 @@
 //! choosing, and needs only `core` plus the runtime's `od` module:
 //! - identity constants at the top (vendor id, product code, default node id
 //!   and bit rate, ...);
-//! - `od`: one zero-sized type per entry ([`entries`]) with its value type
-//!   ([`values`] chooses it: an enum ([`enums`]), a bit-field struct
-//!   ([`bits`]), a scaled newtype ([`scaled`]) or a primitive ([`prim`]));
-//! - `errors`: one enum per device error table ([`errors`]);
-//! - `pdo`: one struct per default PDO ([`pdo`]).
+//! - `od`: one zero-sized type per entry (`entries`) with its value type
+//!   (`values` chooses it: an enum (`enums`), a bit-field struct
+//!   (`bits`), a scaled newtype (`scaled`) or a primitive (`prim`));
+//! - `errors`: one enum per device error table (`errors`);
+//! - `pdo`: one struct per default PDO (`pdo`).
 //!
-//! Every kind of generated type derives one list of traits ([`derives`]).
-//! Every identifier comes from the naming table ([`naming`]); source text
-//! reaches the output only inside doc strings ([`docs`]). Items are emitted
+//! Every kind of generated type derives one list of traits (`derives`).
+//! Every identifier comes from the naming table (`naming`); source text
+//! reaches the output only inside doc strings (`docs`). Items are emitted
 //! in index order and the file is formatted by prettyplease, so the same IR
 //! always gives the same bytes.
 
@@ -22,7 +22,7 @@ mod docs;
 mod entries;
 mod enums;
 mod errors;
-mod naming;
+pub(crate) mod naming;
 mod objects;
 mod pdo;
 mod prim;

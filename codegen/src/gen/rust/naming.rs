@@ -291,6 +291,121 @@ impl Namespace {
     }
 }
 
+/// The Rust names one device's generated code gives its entries: for a
+/// reader of the generated API (the `diff` module) without generating it.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub(crate) struct DeviceNames {
+    /// By (index, subindex): the entry's zero-sized type (`od::Statusword`,
+    /// `od::feedback::Position`) and its value type (`u16`,
+    /// `od::command::PositionValue`, `errors::LinakErrorsCode`,
+    /// `bytes::VisibleString`).
+    pub(crate) entries: BTreeMap<(u16, u8), (String, String)>,
+    /// By index, for ARRAY/RECORD objects: their module (`od::feedback`).
+    pub(crate) modules: BTreeMap<u16, String>,
+    /// By error table name: its enum (`errors::LinakErrors`).
+    pub(crate) error_tables: BTreeMap<String, String>,
+}
+
+/// The names of every generated entry of `device`, requested and resolved
+/// exactly as `entries::emit` (and `errors::plan`) request and resolve them.
+pub(crate) fn device_names(device: &crate::ir::Device) -> DeviceNames {
+    use super::values::{self, Plan};
+    use crate::ir::{Entry, Object, ObjectKind};
+    let mut diags = Diagnostics::new();
+    let error_plans = super::errors::plan(device, &mut diags);
+    let error_plan = |entry: &Entry| -> Option<usize> {
+        let name = entry.semantics.error_table.as_deref()?;
+        error_plans
+            .iter()
+            .position(|p| device.error_tables[p.table].name == name)
+    };
+    let value_type = |plan: &Plan, module: &str, names: &Names| -> String {
+        match plan {
+            Plan::Prim(p) => p.tokens().to_string(),
+            Plan::Bytes(marker) => format!("bytes::{marker}"),
+            Plan::Error(i) => format!("errors::{}", error_plans[*i].code_ident),
+            Plan::Enum { name, .. } | Plan::Bits { name, .. } | Plan::Scaled { name, .. } => {
+                format!("{module}::{}", names.text(*name))
+            }
+        }
+    };
+    let objects: Vec<&Object> = device
+        .objects
+        .values()
+        .filter(|o| !matches!(o.kind, ObjectKind::DefType | ObjectKind::DefStruct))
+        .filter(|o| !o.entries.is_empty())
+        .collect();
+    let is_var = |o: &Object| matches!(o.kind, ObjectKind::Var | ObjectKind::Domain);
+    let mut types = Namespace::new("module `od`", Case::UpperCamel);
+    types.reserve_constructor_names();
+    let mut modules = Namespace::new("module `od`", Case::Snake);
+    let mut root = Vec::new();
+    let mut module_ids = Vec::new();
+    for object in &objects {
+        let key = format!("x{:04X}", object.index);
+        if is_var(object) {
+            let entry = object.entries.values().next().expect("non-empty");
+            let zst = types.request(&object.name, &key, Some(&object.origin));
+            let plan = values::plan(entry, error_plan(entry), &mut types);
+            root.push((object, entry, zst, plan));
+        } else {
+            module_ids.push((
+                object,
+                modules.request(&object.name, &key, Some(&object.origin)),
+            ));
+        }
+    }
+    let type_names = types.resolve(&mut diags);
+    let module_names = modules.resolve(&mut diags);
+    let mut out = DeviceNames::default();
+    for (object, entry, zst, plan) in &root {
+        out.entries.insert(
+            (object.index, entry.subindex),
+            (
+                format!("od::{}", type_names.text(*zst)),
+                value_type(plan, "od", &type_names),
+            ),
+        );
+    }
+    for (object, id) in module_ids {
+        let module = format!("od::{}", module_names.text(id));
+        let mut ns = Namespace::new(format!("module `{module}`"), Case::UpperCamel);
+        ns.reserve_constructor_names();
+        let plans: Vec<_> = object
+            .entries
+            .values()
+            .map(|entry| {
+                let zst = ns.request(
+                    &entry.name,
+                    &format!("sub {}", entry.subindex),
+                    Some(&entry.origin),
+                );
+                let plan = values::plan(entry, error_plan(entry), &mut ns);
+                (entry, zst, plan)
+            })
+            .collect();
+        ns.reserve("INDEX");
+        let names = ns.resolve(&mut diags);
+        for (entry, zst, plan) in &plans {
+            out.entries.insert(
+                (object.index, entry.subindex),
+                (
+                    format!("{module}::{}", names.text(*zst)),
+                    value_type(plan, &module, &names),
+                ),
+            );
+        }
+        out.modules.insert(object.index, module);
+    }
+    for plan in &error_plans {
+        out.error_tables.insert(
+            device.error_tables[plan.table].name.clone(),
+            format!("errors::{}", plan.ident),
+        );
+    }
+    out
+}
+
 fn sep(case: Case) -> &'static str {
     match case {
         Case::UpperCamel => "",
