@@ -1,7 +1,9 @@
-//! The `eds2rust` command line: check, dump, export CANopen object
+//! The `eds2rust` command line: check, dump, export and diff CANopen object
 //! dictionaries, and generate their Rust.
 //!
 //! Exit status: 0 when no input has an error, 1 when one has, 2 on usage errors.
+//! `diff`: 0 without changes at the `--fail-on` level, 1 with, 2 on usage or
+//! input errors.
 #![forbid(unsafe_code)]
 
 use std::io::Write;
@@ -78,6 +80,32 @@ enum Command {
         /// An EDS/DCF file or a YAML object table.
         file: PathBuf,
     },
+    /// Compares two versions of a device: every object, sub, type, access
+    /// right, default, limit, name, semantic and default PDO that changed,
+    /// each classified breaking, additive or compatible (docs/diff.md).
+    Diff {
+        /// A YAML overlay applied on OLD; may be given several times, in order.
+        #[arg(long = "old-overlay", value_name = "FILE")]
+        old_overlays: Vec<PathBuf>,
+        /// A YAML overlay applied on NEW; may be given several times, in order.
+        #[arg(long = "new-overlay", value_name = "FILE")]
+        new_overlays: Vec<PathBuf>,
+        #[arg(long, value_enum, default_value_t = DiffFormat::Text)]
+        format: DiffFormat,
+        /// Exit 1 when a change of this severity or above exists.
+        #[arg(long, value_enum, default_value_t = FailOn::Breaking)]
+        fail_on: FailOn,
+        /// Compare without the YAML-only layer (units, named values, bit
+        /// fields, error tables, PDO labels): for an EDS against a YAML table.
+        #[arg(long)]
+        ignore_semantics: bool,
+        #[command(flatten)]
+        read: ReadArgs,
+        /// The old version: an EDS/DCF file or a YAML object table.
+        old: PathBuf,
+        /// The new version: an EDS/DCF file or a YAML object table.
+        new: PathBuf,
+    },
 }
 
 /// How strictly to read, and the levels of single rules.
@@ -129,13 +157,36 @@ enum ExportFormat {
     Eds,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum DiffFormat {
+    /// One line per change and a summary line.
+    Text,
+    /// One JSON object.
+    Json,
+    /// A Markdown table for a review comment.
+    Markdown,
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
+enum FailOn {
+    /// Breaking changes.
+    Breaking,
+    /// Breaking or additive changes.
+    Additive,
+    /// Any change.
+    Any,
+    /// Exit 0 whatever changed.
+    Never,
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let read = match &cli.command {
         Command::Check { read, .. }
         | Command::Dump { read, .. }
         | Command::Export { read, .. }
-        | Command::Generate { read, .. } => read.options(),
+        | Command::Generate { read, .. }
+        | Command::Diff { read, .. } => read.options(),
     };
     let options = match read {
         Ok(options) => options,
@@ -176,6 +227,83 @@ fn main() -> ExitCode {
             },
             &options.levels,
         ),
+        Command::Diff {
+            old_overlays,
+            new_overlays,
+            format,
+            fail_on,
+            ignore_semantics,
+            old,
+            new,
+            ..
+        } => diff(
+            (&old, &old_overlays),
+            (&new, &new_overlays),
+            format,
+            fail_on,
+            &eds2rust::diff::Options { ignore_semantics },
+            &options,
+        ),
+    }
+}
+
+/// Reads one side of a diff; `None` (its diagnostics printed) on errors.
+fn diff_side(
+    path: &std::path::Path,
+    overlays: &[PathBuf],
+    options: &Options,
+) -> Option<eds2rust::ir::Device> {
+    let loaded = eds2rust::build::load_device(path, overlays, options);
+    let d = &loaded.diagnostics;
+    match loaded.device {
+        Some(device) if !d.has_errors() => Some(device),
+        _ => {
+            let mut err = std::io::stderr().lock();
+            let _ = write!(err, "{}", d.render());
+            let _ = writeln!(
+                err,
+                "{}: not compared: {} errors",
+                path.display(),
+                d.error_count().max(1)
+            );
+            None
+        }
+    }
+}
+
+fn diff(
+    (old, old_overlays): (&std::path::Path, &[PathBuf]),
+    (new, new_overlays): (&std::path::Path, &[PathBuf]),
+    format: DiffFormat,
+    fail_on: FailOn,
+    diff_options: &eds2rust::diff::Options,
+    options: &Options,
+) -> ExitCode {
+    use eds2rust::diff::{Severity, render};
+    let old_device = diff_side(old, old_overlays, options);
+    let new_device = diff_side(new, new_overlays, options);
+    let (Some(old_device), Some(new_device)) = (old_device, new_device) else {
+        return ExitCode::from(2);
+    };
+    let changes = eds2rust::diff::diff_with(&old_device, &new_device, diff_options);
+    let (old_name, new_name) = (old.display().to_string(), new.display().to_string());
+    let text = match format {
+        DiffFormat::Text => render::text(&changes),
+        DiffFormat::Json => render::json(&old_name, &new_name, &changes),
+        DiffFormat::Markdown => render::markdown(&old_name, &new_name, &changes),
+    };
+    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+    let threshold = match fail_on {
+        FailOn::Breaking => Some(Severity::Breaking),
+        FailOn::Additive => Some(Severity::Additive),
+        FailOn::Any => Some(Severity::Compatible),
+        FailOn::Never => None,
+    };
+    let fails = threshold.is_some_and(|t| changes.iter().any(|c| c.severity >= t));
+    if fails {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
     }
 }
 

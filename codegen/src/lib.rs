@@ -11,6 +11,8 @@
 //! - [`ir`]: the object-dictionary model, plain data;
 //! - `dump` (feature `json`): IR → JSON for tools and tests;
 //! - `gen` (`r#gen`: `gen` is a reserved word in Rust 2024): IR → files: an EDS (CiA 306) export, product variants applied;
+//! - [`diff`]: a semantic diff of two devices, each change classified
+//!   breaking, additive or compatible (`eds2rust diff`);
 //! - [`diag`]: diagnostics with file, line, section and key;
 //! - [`build`]: the build-script API ([`Builder`], in the shape of
 //!   prost-build) and the pure [`generate`]: input + overlays → Rust source.
@@ -18,6 +20,7 @@
 
 pub mod build;
 pub mod diag;
+pub mod diff;
 #[cfg(feature = "json")]
 pub mod dump;
 pub mod eds;

@@ -11,7 +11,8 @@ use quote::quote;
 
 use super::docs::{self, Doc};
 use super::errors::ErrorPlan;
-use super::naming::{Case, Names, Namespace};
+use super::naming::Names;
+use super::od_plan;
 use super::prim::Prim;
 use super::values::{self, Plan};
 use crate::diag::Diagnostics;
@@ -50,102 +51,49 @@ pub(crate) struct Ctx<'a> {
     pub(crate) diags: &'a mut Diagnostics,
 }
 
-fn error_plan(cx: &Ctx, entry: &Entry) -> Option<usize> {
-    let name = entry.semantics.error_table.as_deref()?;
-    cx.errors
-        .iter()
-        .position(|p| cx.device.error_tables[p.table].name == name)
-}
-
 /// The `od` module's items, and the info of every entry by (index, subindex).
 pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>) {
-    let device = cx.device;
-    let objects: Vec<&Object> = device
-        .objects
-        .values()
-        .filter(|o| !matches!(o.kind, ObjectKind::DefType | ObjectKind::DefStruct))
-        .filter(|o| !o.entries.is_empty())
-        .collect();
-    let is_var = |o: &Object| matches!(o.kind, ObjectKind::Var | ObjectKind::Domain);
-    // Names in `od`: types of VAR objects (and their value types), modules of
-    // the others.
-    let mut types = Namespace::new("module `od`", Case::UpperCamel);
-    types.reserve_constructor_names();
-    let mut modules = Namespace::new("module `od`", Case::Snake);
-    let mut root_plans = Vec::new();
-    let mut module_ids = Vec::new();
-    for object in &objects {
-        let key = format!("x{:04X}", object.index);
-        if is_var(object) {
-            let entry = object.entries.values().next().expect("non-empty");
-            let zst = types.request(&object.name, &key, Some(&object.origin));
-            let plan = values::plan(entry, error_plan(cx, entry), &mut types);
-            root_plans.push((object, entry, zst, plan));
-        } else {
-            module_ids.push((
-                object,
-                modules.request(&object.name, &key, Some(&object.origin)),
-            ));
-        }
-    }
-    let type_names = types.resolve(cx.diags);
-    let module_names = modules.resolve(cx.diags);
+    let od = od_plan::plan(cx.device, cx.errors, cx.diags);
     let mut infos = BTreeMap::new();
     let mut items = TokenStream::new();
-    for (object, entry, zst, plan) in &root_plans {
-        let ident = type_names.get(*zst);
+    for root in &od.root {
+        let (object, e) = (root.object, &root.entry);
+        let ident = od.root_names.get(e.zst);
         let path = vec![super::naming::ident("od")];
         items.extend(entry_items(
             cx,
             object,
-            entry,
+            e.entry,
             &ident,
-            plan,
-            &type_names,
+            &e.value,
+            &od.root_names,
             &path,
             &object.name,
         ));
         infos.insert(
-            (object.index, entry.subindex),
-            info(cx, &path, plan, &type_names),
+            (object.index, e.entry.subindex),
+            info(cx, &path, &e.value, &od.root_names),
         );
     }
-    for (object, id) in module_ids {
-        let module = module_names.get(id);
+    for m in &od.modules {
+        let (object, module) = (m.object, &m.module);
         let path = vec![super::naming::ident("od"), module.clone()];
-        let mut ns = Namespace::new(format!("module `od::{module}`"), Case::UpperCamel);
-        ns.reserve_constructor_names();
-        let plans: Vec<_> = object
-            .entries
-            .values()
-            .map(|entry| {
-                let zst = ns.request(
-                    &entry.name,
-                    &format!("sub {}", entry.subindex),
-                    Some(&entry.origin),
-                );
-                let plan = values::plan(entry, error_plan(cx, entry), &mut ns);
-                (entry, zst, plan)
-            })
-            .collect();
-        ns.reserve("INDEX");
-        let names = ns.resolve(cx.diags);
         let mut inner = TokenStream::new();
-        for (entry, zst, plan) in &plans {
-            let ident = names.get(*zst);
+        for e in &m.entries {
+            let ident = m.names.get(e.zst);
             inner.extend(entry_items(
                 cx,
                 object,
-                entry,
+                e.entry,
                 &ident,
-                plan,
-                &names,
+                &e.value,
+                &m.names,
                 &path,
-                &entry.name,
+                &e.entry.name,
             ));
             infos.insert(
-                (object.index, entry.subindex),
-                info(cx, &path, plan, &names),
+                (object.index, e.entry.subindex),
+                info(cx, &path, &e.value, &m.names),
             );
         }
         let mut doc = Doc::new();

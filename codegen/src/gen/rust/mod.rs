@@ -24,6 +24,7 @@ mod enums;
 mod errors;
 pub(crate) mod naming;
 mod objects;
+pub(crate) mod od_plan;
 mod pdo;
 mod prim;
 mod scaled;

@@ -1,0 +1,192 @@
+//! The plan of the `od` module: which entry gets which Rust name and which
+//! value type. The one place these are decided: the emitter (`entries`)
+//! writes the plan out as code, and readers of the generated API (the
+//! `diff` module, through [`device_names`]) read the same plan without
+//! generating anything.
+
+use std::collections::BTreeMap;
+
+use proc_macro2::Ident;
+
+use super::errors::{self, ErrorPlan};
+use super::naming::{Case, NameId, Names, Namespace};
+use super::values::{self, Plan};
+use crate::diag::Diagnostics;
+use crate::ir::{Device, Entry, Object, ObjectKind};
+
+/// One entry's names: its zero-sized type and its value type's plan.
+pub(crate) struct EntryPlan<'d> {
+    pub(crate) entry: &'d Entry,
+    pub(crate) zst: NameId,
+    pub(crate) value: Plan,
+}
+
+/// A VAR (or DOMAIN) object: its entry's types live in `od` itself.
+pub(crate) struct RootPlan<'d> {
+    pub(crate) object: &'d Object,
+    pub(crate) entry: EntryPlan<'d>,
+}
+
+/// An ARRAY or RECORD object: a module in `od` with one type per sub.
+pub(crate) struct ModulePlan<'d> {
+    pub(crate) object: &'d Object,
+    pub(crate) module: Ident,
+    pub(crate) entries: Vec<EntryPlan<'d>>,
+    /// The names of the module's scope.
+    pub(crate) names: Names,
+}
+
+pub(crate) struct OdPlan<'d> {
+    pub(crate) root: Vec<RootPlan<'d>>,
+    /// The names of `od`'s own scope (root types and their value types).
+    pub(crate) root_names: Names,
+    pub(crate) modules: Vec<ModulePlan<'d>>,
+}
+
+/// The error plan an entry's codes come from, by position in `errors`.
+pub(crate) fn error_plan(device: &Device, errors: &[ErrorPlan], entry: &Entry) -> Option<usize> {
+    let name = entry.semantics.error_table.as_deref()?;
+    errors
+        .iter()
+        .position(|p| device.error_tables[p.table].name == name)
+}
+
+/// Requests and resolves every name of `od`; name collisions are reported
+/// into `diags`.
+pub(crate) fn plan<'d>(
+    device: &'d Device,
+    errors: &[ErrorPlan],
+    diags: &mut Diagnostics,
+) -> OdPlan<'d> {
+    let objects: Vec<&Object> = device
+        .objects
+        .values()
+        .filter(|o| !matches!(o.kind, ObjectKind::DefType | ObjectKind::DefStruct))
+        .filter(|o| !o.entries.is_empty())
+        .collect();
+    let is_var = |o: &Object| matches!(o.kind, ObjectKind::Var | ObjectKind::Domain);
+    // Names in `od`: types of VAR objects (and their value types), modules of
+    // the others.
+    let mut types = Namespace::new("module `od`", Case::UpperCamel);
+    types.reserve_constructor_names();
+    let mut modules = Namespace::new("module `od`", Case::Snake);
+    let mut root = Vec::new();
+    let mut module_ids = Vec::new();
+    for object in objects {
+        let key = format!("x{:04X}", object.index);
+        if is_var(object) {
+            let entry = object.entries.values().next().expect("non-empty");
+            let zst = types.request(&object.name, &key, Some(&object.origin));
+            let value = values::plan(entry, error_plan(device, errors, entry), &mut types);
+            root.push(RootPlan {
+                object,
+                entry: EntryPlan { entry, zst, value },
+            });
+        } else {
+            module_ids.push((
+                object,
+                modules.request(&object.name, &key, Some(&object.origin)),
+            ));
+        }
+    }
+    let root_names = types.resolve(diags);
+    let module_names = modules.resolve(diags);
+    let modules = module_ids
+        .into_iter()
+        .map(|(object, id)| {
+            let module = module_names.get(id);
+            let mut ns = Namespace::new(format!("module `od::{module}`"), Case::UpperCamel);
+            ns.reserve_constructor_names();
+            let entries: Vec<EntryPlan> = object
+                .entries
+                .values()
+                .map(|entry| {
+                    let zst = ns.request(
+                        &entry.name,
+                        &format!("sub {}", entry.subindex),
+                        Some(&entry.origin),
+                    );
+                    let value = values::plan(entry, error_plan(device, errors, entry), &mut ns);
+                    EntryPlan { entry, zst, value }
+                })
+                .collect();
+            ns.reserve("INDEX");
+            let names = ns.resolve(diags);
+            ModulePlan {
+                object,
+                module,
+                entries,
+                names,
+            }
+        })
+        .collect();
+    OdPlan {
+        root,
+        root_names,
+        modules,
+    }
+}
+
+/// The Rust names one device's generated code gives its entries: for a
+/// reader of the generated API (the `diff` module) without generating it.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub(crate) struct DeviceNames {
+    /// By (index, subindex): the entry's zero-sized type (`od::Statusword`,
+    /// `od::feedback::Position`) and its value type (`u16`,
+    /// `od::command::PositionValue`, `errors::LinakErrorsCode`,
+    /// `bytes::VisibleString`).
+    pub(crate) entries: BTreeMap<(u16, u8), (String, String)>,
+    /// By index, for ARRAY/RECORD objects: their module (`od::feedback`).
+    pub(crate) modules: BTreeMap<u16, String>,
+    /// By error table name: its enum (`errors::LinakErrors`).
+    pub(crate) error_tables: BTreeMap<String, String>,
+}
+
+/// The names of every generated entry of `device`, from the same plan the
+/// generator writes out.
+pub(crate) fn device_names(device: &Device) -> DeviceNames {
+    let mut diags = Diagnostics::new();
+    let error_plans = errors::plan(device, &mut diags);
+    let od = plan(device, &error_plans, &mut diags);
+    let value_type = |plan: &Plan, module: &str, names: &Names| -> String {
+        match plan {
+            Plan::Prim(p) => p.tokens().to_string(),
+            Plan::Bytes(marker) => format!("bytes::{marker}"),
+            Plan::Error(i) => format!("errors::{}", error_plans[*i].code_ident),
+            Plan::Enum { name, .. } | Plan::Bits { name, .. } | Plan::Scaled { name, .. } => {
+                format!("{module}::{}", names.text(*name))
+            }
+        }
+    };
+    let mut out = DeviceNames::default();
+    for root in &od.root {
+        let e = &root.entry;
+        out.entries.insert(
+            (root.object.index, e.entry.subindex),
+            (
+                format!("od::{}", od.root_names.text(e.zst)),
+                value_type(&e.value, "od", &od.root_names),
+            ),
+        );
+    }
+    for m in &od.modules {
+        let module = format!("od::{}", m.module);
+        for e in &m.entries {
+            out.entries.insert(
+                (m.object.index, e.entry.subindex),
+                (
+                    format!("{module}::{}", m.names.text(e.zst)),
+                    value_type(&e.value, &module, &m.names),
+                ),
+            );
+        }
+        out.modules.insert(m.object.index, module);
+    }
+    for plan in &error_plans {
+        out.error_tables.insert(
+            device.error_tables[plan.table].name.clone(),
+            format!("errors::{}", plan.ident),
+        );
+    }
+    out
+}

@@ -1,0 +1,277 @@
+//! `eds2rust::diff` on every file of ../shared/eds-corpus: a file against
+//! itself has no changes; against a copy mutated in the IR (an object
+//! removed, an access right narrowed, a default changed, a standard object
+//! renamed, with and without changing its Rust path) and in the text (an
+//! access right rewritten in its EDS export) the diff finds exactly that
+//! change with the expected severity.
+
+use eds2rust::diff::{self, Change, Kind, Severity};
+use eds2rust::eds::{Options, read_bytes, read_file};
+use eds2rust::ir::{Access, Device, ObjectKind, Value, pdo::is_mapping_object};
+
+fn pdo_object(index: u16) -> bool {
+    (0x1400..=0x1BFF).contains(&index)
+}
+
+/// The changes other than the Rust paths that naming shifted around.
+fn without_path_shifts(changes: &[Change]) -> Vec<&Change> {
+    changes
+        .iter()
+        .filter(|c| c.kind != Kind::RustPathChanged)
+        .collect()
+}
+
+fn one(changes: &[Change], what: &str) -> Change {
+    assert_eq!(changes.len(), 1, "{what}: {changes:#?}");
+    changes[0].clone()
+}
+
+#[test]
+fn corpus_files_against_themselves_and_mutations() {
+    let Some(files) = eds2rust_tests::corpus_files("diff corpus test") else {
+        return;
+    };
+    let mut counts = [0usize; 5];
+    for path in &files {
+        let name = path.display().to_string();
+        let device = read_file(path, &Options::default())
+            .device
+            .expect("a readable file gives a device");
+        assert_eq!(
+            diff::diff(&device, &device),
+            Vec::<Change>::new(),
+            "{name}: against itself"
+        );
+        let generated: Vec<u16> = device
+            .objects
+            .values()
+            .filter(|o| !matches!(o.kind, ObjectKind::DefType | ObjectKind::DefStruct))
+            .filter(|o| !o.entries.is_empty() && !pdo_object(o.index))
+            .map(|o| o.index)
+            .collect();
+
+        // An object removed: breaking, at its index, named by the old path.
+        if let Some(&index) = generated.last() {
+            let mut mutated = device.clone();
+            mutated.objects.remove(&index);
+            let changes = diff::diff(&device, &mutated);
+            let removed = without_path_shifts(&changes);
+            assert_eq!(removed.len(), 1, "{name}: {removed:#?}");
+            let c = removed[0];
+            assert_eq!(
+                (c.index, c.kind, c.severity),
+                (index, Kind::ObjectRemoved, Severity::Breaking),
+                "{name}"
+            );
+            assert!(
+                c.rust_path
+                    .as_deref()
+                    .is_some_and(|p| p.starts_with("od::")),
+                "{name}: {c:?}"
+            );
+            assert!(
+                changes.iter().all(|c| c.severity == Severity::Breaking),
+                "{name}"
+            );
+            counts[0] += 1;
+        }
+
+        // An access right narrowed (rw → ro): breaking, nothing else.
+        let rw = device
+            .objects
+            .values()
+            .flat_map(|o| o.entries.values().map(move |e| (o.index, e)))
+            .find(|(_, e)| e.access == Access::Rw);
+        if let Some((index, entry)) = rw {
+            let mut mutated = device.clone();
+            mutated
+                .objects
+                .get_mut(&index)
+                .unwrap()
+                .entries
+                .get_mut(&entry.subindex)
+                .unwrap()
+                .access = Access::Ro;
+            let c = one(&diff::diff(&device, &mutated), &name);
+            assert_eq!(
+                (c.index, c.subindex, c.kind, c.severity),
+                (
+                    index,
+                    Some(entry.subindex),
+                    Kind::AccessChanged,
+                    Severity::Breaking
+                ),
+                "{name}"
+            );
+            // The other way it widens.
+            let c = one(&diff::diff(&mutated, &device), &name);
+            assert_eq!(
+                (c.kind, c.severity),
+                (Kind::AccessChanged, Severity::Additive),
+                "{name}"
+            );
+            counts[1] += 1;
+        }
+
+        // A plain integer default changed: compatible.
+        let with_default = device
+            .objects
+            .values()
+            .filter(|o| !is_mapping_object(o.index) && !pdo_object(o.index))
+            .flat_map(|o| o.entries.values().map(move |e| (o.index, e)))
+            .find(|(_, e)| {
+                e.parameter_value.is_none()
+                    && e.default
+                        .as_ref()
+                        .is_some_and(|d| !d.plus_node_id && matches!(d.value, Value::Integer(_)))
+            });
+        if let Some((index, entry)) = with_default {
+            let mut mutated = device.clone();
+            let target = mutated
+                .objects
+                .get_mut(&index)
+                .unwrap()
+                .entries
+                .get_mut(&entry.subindex)
+                .unwrap();
+            let literal = target.default.as_mut().unwrap();
+            if let Value::Integer(v) = &mut literal.value {
+                *v ^= 1;
+            }
+            let c = one(&diff::diff(&device, &mutated), &name);
+            assert_eq!(
+                (c.index, c.subindex, c.kind, c.severity),
+                (
+                    index,
+                    Some(entry.subindex),
+                    Kind::DefaultChanged,
+                    Severity::Compatible
+                ),
+                "{name}"
+            );
+            counts[2] += 1;
+        }
+
+        // A standard object renamed: breaking when its Rust name changes,
+        // compatible when only the spelling of the source name does.
+        if let Some(object) = [0x1018u16, 0x1000, 0x1001, 0x1017]
+            .iter()
+            .find_map(|i| device.objects.get(i))
+        {
+            let index = object.index;
+            let mut renamed = device.clone();
+            renamed.objects.get_mut(&index).unwrap().name = format!("{} renamed", object.name);
+            let changes = diff::diff(&device, &renamed);
+            let c = without_path_shifts(&changes);
+            assert_eq!(c.len(), 1, "{name}: {c:#?}");
+            assert_eq!(
+                (c[0].index, c[0].subindex, c[0].kind, c[0].severity),
+                (index, None, Kind::NameChanged, Severity::Breaking),
+                "{name}"
+            );
+            let mut respelled = device.clone();
+            respelled.objects.get_mut(&index).unwrap().name = format!("{}!", object.name);
+            let c = one(&diff::diff(&device, &respelled), &name);
+            assert_eq!(
+                (c.kind, c.severity),
+                (Kind::NameChanged, Severity::Compatible),
+                "{name}: {c:?}"
+            );
+            counts[3] += 1;
+        }
+
+        // A text mutation: the device exported as EDS, one `AccessType=rw`
+        // of an object outside the PDO range rewritten as `wo`, read back.
+        let text = eds2rust::r#gen::to_eds(&device);
+        let base = read_bytes("export.eds", text.as_bytes(), &Options::default());
+        let Some(base) = base.device else { continue };
+        if let Some(mutated_text) = narrow_in_text(&text) {
+            let mutated = read_bytes("mutated.eds", mutated_text.as_bytes(), &Options::default())
+                .device
+                .expect("device");
+            let c = one(&diff::diff(&base, &mutated), &name);
+            assert_eq!(
+                (c.kind, c.severity),
+                (Kind::AccessChanged, Severity::Breaking),
+                "{name}: {c:?}"
+            );
+            assert_eq!(c.old, Some(diff::Val::Text("rw".into())), "{name}");
+            counts[4] += 1;
+        }
+    }
+    println!(
+        "{} files: {} removals, {} narrowed, {} defaults, {} renames, {} text mutations",
+        files.len(),
+        counts[0],
+        counts[1],
+        counts[2],
+        counts[3],
+        counts[4]
+    );
+    assert!(
+        counts.iter().all(|&n| n > 0),
+        "every mutation ran on some file: {counts:?}"
+    );
+}
+
+/// The EDS text with the first `AccessType=rw` of a section outside
+/// 0x1400–0x1BFF turned into `wo`.
+fn narrow_in_text(text: &str) -> Option<String> {
+    let mut section_ok = false;
+    let mut out = String::with_capacity(text.len());
+    let mut done = false;
+    for line in text.split_inclusive('\n') {
+        let trimmed = line.trim();
+        if let Some(name) = trimmed.strip_prefix('[').and_then(|s| s.strip_suffix(']')) {
+            section_ok =
+                u16::from_str_radix(name.get(..4).unwrap_or(""), 16).is_ok_and(|i| !pdo_object(i));
+        }
+        if !done && section_ok && trimmed.eq_ignore_ascii_case("AccessType=rw") {
+            out.push_str(&line.replacen("rw", "wo", 1));
+            done = true;
+        } else {
+            out.push_str(line);
+        }
+    }
+    done.then_some(out)
+}
+
+#[test]
+fn device_without_objects_against_itself() {
+    assert!(diff::diff(&Device::default(), &Device::default()).is_empty());
+}
+
+/// The Rust paths the diff names are those of the generated code: for
+/// every corpus file, each added object's path (against an empty device)
+/// is a `pub struct` or `pub mod` of the code generated from the file.
+#[test]
+fn rust_paths_match_generated_code() {
+    let Some(files) = eds2rust_tests::corpus_files("diff rust-path test") else {
+        return;
+    };
+    for path in &files {
+        let name = path.display().to_string();
+        let Ok(code) = eds2rust::generate(path, &[], &Default::default()) else {
+            continue;
+        };
+        let device = read_file(path, &Options::default()).device.expect("device");
+        for c in diff::diff(&Device::default(), &device) {
+            if c.kind != Kind::ObjectAdded {
+                continue;
+            }
+            let Some(p) = c.rust_path.as_deref() else {
+                continue;
+            };
+            let last = p.rsplit("::").next().unwrap();
+            let item = if last.starts_with(|ch: char| ch.is_ascii_lowercase()) {
+                format!("pub mod {last} {{")
+            } else {
+                format!("pub struct {last};")
+            };
+            assert!(
+                code.contains(&item),
+                "{name}: {p} (`{item}`) is not generated"
+            );
+        }
+    }
+}
