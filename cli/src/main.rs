@@ -1,5 +1,5 @@
 //! The `eds2rust` command line: check, dump, export and diff CANopen object
-//! dictionaries, and generate their Rust.
+//! dictionaries, generate their Rust and list its API.
 //!
 //! Exit status: 0 when no input has an error, 1 when one has, 2 on usage errors.
 //! `diff`: 0 without changes at the `--fail-on` level, 1 with, 2 on usage or
@@ -75,6 +75,19 @@ enum Command {
         /// Write here instead of standard output (replaced only when complete).
         #[arg(long, short)]
         output: Option<PathBuf>,
+        #[command(flatten)]
+        read: ReadArgs,
+        /// An EDS/DCF file or a YAML object table.
+        file: PathBuf,
+    },
+    /// Prints a compact listing of the generated API of one device, one
+    /// line per public item (docs/api-listing.md), for a snapshot test.
+    /// Diagnostics go to stderr; nothing is printed when there is an error.
+    Api {
+        /// A YAML overlay table (without `base:`) applied on the input; may
+        /// be given several times, applied in order.
+        #[arg(long = "overlay", value_name = "FILE")]
+        overlays: Vec<PathBuf>,
         #[command(flatten)]
         read: ReadArgs,
         /// An EDS/DCF file or a YAML object table.
@@ -186,6 +199,7 @@ fn main() -> ExitCode {
         | Command::Dump { read, .. }
         | Command::Export { read, .. }
         | Command::Generate { read, .. }
+        | Command::Api { read, .. }
         | Command::Diff { read, .. } => read.options(),
     };
     let options = match read {
@@ -227,6 +241,7 @@ fn main() -> ExitCode {
             },
             &options.levels,
         ),
+        Command::Api { overlays, file, .. } => api(&file, &overlays, &options),
         Command::Diff {
             old_overlays,
             new_overlays,
@@ -410,6 +425,28 @@ fn generate(
         }
     };
     write_output(output, &code)
+}
+
+fn api(path: &std::path::Path, overlays: &[PathBuf], options: &Options) -> ExitCode {
+    match eds2rust::r#gen::rust::api_listing_files(path, overlays, options) {
+        Ok(listing) => {
+            let _ = write!(std::io::stderr().lock(), "{}", listing.warnings.render());
+            let _ = std::io::stdout().lock().write_all(listing.text.as_bytes());
+            ExitCode::SUCCESS
+        }
+        Err(mut diagnostics) => {
+            diagnostics.errors_first();
+            let mut err = std::io::stderr().lock();
+            let _ = write!(err, "{}", diagnostics.render());
+            let _ = writeln!(
+                err,
+                "{}: not listed: {} errors",
+                path.display(),
+                diagnostics.error_count().max(1)
+            );
+            ExitCode::from(1)
+        }
+    }
 }
 
 /// Writes `text` to standard output, or whole to `output`.

@@ -6,7 +6,8 @@
 //! - downstream/sim-device: the generic simulator of a device of its own,
 //!   with no SocketCAN, tokio or seed drivers in its dependency graph;
 //! - downstream/vendor-drive: a vendor DCF of ../shared/eds-corpus with an
-//!   overlay and rule levels (not run without ../shared: it reads the DCF).
+//!   overlay and rule levels (not run without ../shared: it reads the DCF);
+//! - downstream/api-lock: the listing of a generated API locked with insta.
 
 use std::path::Path;
 use std::process::Command;
@@ -16,10 +17,16 @@ use eds2rust_tests::{not_run, shared_dir, target_dir, workspace_root};
 /// Runs `cargo <args>` in the downstream crate `name`, failing with its
 /// output when it fails.
 fn cargo(name: &str, args: &[&str]) -> String {
+    cargo_env(name, args, &[])
+}
+
+/// [`cargo`] with variables set for it.
+fn cargo_env(name: &str, args: &[&str], envs: &[(&str, &str)]) -> String {
     let dir = workspace_root().join("downstream").join(name);
     let target = target_dir().join("downstream");
     let out = Command::new(env!("CARGO"))
         .args(args)
+        .envs(envs.iter().copied())
         .arg("--locked")
         .current_dir(&dir)
         .env("CARGO_TARGET_DIR", &target)
@@ -112,4 +119,36 @@ fn vendor_drive_builds_from_its_dcf_without_warnings() {
     crates.sort();
     crates.dedup();
     assert!(crates.len() <= 32, "{} crates: {crates:?}", crates.len());
+}
+
+/// Its snapshot test locks the listing of the generated API of the LINAK
+/// table (downstream/api-lock/tests/api.rs). With `CI` set, insta fails on a
+/// mismatch and writes nothing, whatever `INSTA_UPDATE` the caller has.
+#[test]
+fn api_lock_matches_its_committed_snapshot() {
+    let dir = workspace_root().join("downstream/api-lock");
+    assert!(dir.join("Cargo.lock").is_file(), "a lock file of its own");
+    let snapshots = dir.join("tests/snapshots");
+    assert!(snapshots.join("api__linak_api.snap").is_file());
+    let output = cargo_env(
+        "api-lock",
+        &["test"],
+        &[
+            ("CI", "true"),
+            ("INSTA_UPDATE", "no"),
+            ("INSTA_FORCE_PASS", "0"),
+            ("INSTA_FORCE_UPDATE", "0"),
+        ],
+    );
+    assert!(
+        output.contains("test the_generated_api_is_locked ... ok"),
+        "{output}"
+    );
+    assert!(!output.contains("test result: FAILED"), "{output}");
+    let pending: Vec<_> = std::fs::read_dir(&snapshots)
+        .expect("snapshots directory")
+        .map(|e| e.expect("directory entry").path())
+        .filter(|p| p.extension().is_some_and(|x| x == "new"))
+        .collect();
+    assert!(pending.is_empty(), "{pending:?}");
 }

@@ -16,6 +16,7 @@
 //! in index order and the file is formatted by prettyplease, so the same IR
 //! always gives the same bytes.
 
+mod api;
 mod bits;
 mod derives;
 mod docs;
@@ -29,6 +30,8 @@ mod pdo;
 mod prim;
 mod scaled;
 mod values;
+
+pub use api::{ApiListing, api_listing, api_listing_files};
 
 use proc_macro2::TokenStream;
 use quote::quote;

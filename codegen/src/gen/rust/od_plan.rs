@@ -127,6 +127,25 @@ pub(crate) fn plan<'d>(
     }
 }
 
+/// The path of an entry's value type as planned (`u16`,
+/// `od::command::PositionValue`, `errors::LinakErrorsCode`,
+/// `bytes::VisibleString`); `module` is the entry's module (`od::feedback`).
+pub(crate) fn value_type_path(
+    plan: &Plan,
+    module: &str,
+    names: &Names,
+    errors: &[ErrorPlan],
+) -> String {
+    match plan {
+        Plan::Prim(p) => p.tokens().to_string(),
+        Plan::Bytes(marker) => format!("bytes::{marker}"),
+        Plan::Error(i) => format!("errors::{}", errors[*i].code_ident),
+        Plan::Enum { name, .. } | Plan::Bits { name, .. } | Plan::Scaled { name, .. } => {
+            format!("{module}::{}", names.text(*name))
+        }
+    }
+}
+
 /// The Rust names one device's generated code gives its entries: for a
 /// reader of the generated API (the `diff` module) without generating it.
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -148,15 +167,8 @@ pub(crate) fn device_names(device: &Device) -> DeviceNames {
     let mut diags = Diagnostics::new();
     let error_plans = errors::plan(device, &mut diags);
     let od = plan(device, &error_plans, &mut diags);
-    let value_type = |plan: &Plan, module: &str, names: &Names| -> String {
-        match plan {
-            Plan::Prim(p) => p.tokens().to_string(),
-            Plan::Bytes(marker) => format!("bytes::{marker}"),
-            Plan::Error(i) => format!("errors::{}", error_plans[*i].code_ident),
-            Plan::Enum { name, .. } | Plan::Bits { name, .. } | Plan::Scaled { name, .. } => {
-                format!("{module}::{}", names.text(*name))
-            }
-        }
+    let value_type = |plan: &Plan, module: &str, names: &Names| {
+        value_type_path(plan, module, names, &error_plans)
     };
     let mut out = DeviceNames::default();
     for root in &od.root {

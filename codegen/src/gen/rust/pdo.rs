@@ -17,35 +17,45 @@ use crate::ir::pdo::{MappedObject, MappingProblem, check_entry, is_mapping_objec
 use crate::ir::{DataType, Device, Object, PdoDirection, Value};
 
 /// One field of a PDO: a mapped entry at a bit offset.
-struct Field<'a> {
+pub(crate) struct Field<'a> {
     target: MappedObject,
-    offset: u32,
-    width: u32,
-    info: &'a EntryInfo,
+    pub(crate) offset: u32,
+    pub(crate) width: u32,
+    pub(crate) info: &'a EntryInfo,
     raw: Prim,
     entry_name: &'a str,
     data_type: DataType,
-    name: NameId,
+    pub(crate) name: NameId,
 }
 
-struct Layout<'a> {
-    mapping: &'a Object,
-    direction: PdoDirection,
-    number: u16,
-    fields: Vec<Field<'a>>,
-    gaps: Vec<(u32, u32, DataType)>,
+pub(crate) struct Layout<'a> {
+    pub(crate) mapping: &'a Object,
+    pub(crate) direction: PdoDirection,
+    pub(crate) number: u16,
+    pub(crate) fields: Vec<Field<'a>>,
+    /// The dummy entries: offset, width, type.
+    pub(crate) gaps: Vec<(u32, u32, DataType)>,
     /// The mapping entries in order, dummies included (`index << 16 | sub << 8 | bits`).
     entries: Vec<u32>,
-    total: u32,
+    /// Mapped bits in all.
+    pub(crate) total: u32,
 }
 
-/// The `pdo` module's items (empty when the device has no default PDO).
-pub(crate) fn emit(
-    device: &Device,
-    infos: &BTreeMap<(u16, u8), EntryInfo>,
-    rt: &TokenStream,
+/// One planned PDO struct: its layout, label, name and field names.
+pub(crate) struct Planned<'a> {
+    pub(crate) layout: Layout<'a>,
+    label: Option<&'a crate::ir::PdoLabel>,
+    pub(crate) ident: proc_macro2::Ident,
+    pub(crate) fields: super::naming::Names,
+}
+
+/// Lays out every default PDO and resolves the names of the structs and
+/// their fields, in the order `emit` writes them (and `api` lists them).
+pub(crate) fn plan<'a>(
+    device: &'a Device,
+    infos: &'a BTreeMap<(u16, u8), EntryInfo>,
     diags: &mut Diagnostics,
-) -> TokenStream {
+) -> Vec<Planned<'a>> {
     let mut structs = Namespace::new("module `pdo`", Case::UpperCamel);
     let mut planned = Vec::new();
     for mapping in device
@@ -76,17 +86,28 @@ pub(crate) fn emit(
         planned.push((layout, fields_ns, label, id));
     }
     let names = structs.resolve(diags);
-    let mut out = TokenStream::new();
-    for (layout, fields_ns, label, id) in planned {
-        let field_names = fields_ns.resolve(diags);
-        let ident = names.get(id);
-        out.extend(emit_struct(
-            device,
-            &layout,
-            &ident,
+    planned
+        .into_iter()
+        .map(|(layout, fields_ns, label, id)| Planned {
+            fields: fields_ns.resolve(diags),
+            ident: names.get(id),
+            layout,
             label,
-            &field_names,
-            rt,
+        })
+        .collect()
+}
+
+/// The `pdo` module's items (empty when the device has no default PDO).
+pub(crate) fn emit(
+    device: &Device,
+    infos: &BTreeMap<(u16, u8), EntryInfo>,
+    rt: &TokenStream,
+    diags: &mut Diagnostics,
+) -> TokenStream {
+    let mut out = TokenStream::new();
+    for p in plan(device, infos, diags) {
+        out.extend(emit_struct(
+            device, &p.layout, &p.ident, p.label, &p.fields, rt,
         ));
     }
     out

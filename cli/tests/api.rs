@@ -1,0 +1,78 @@
+//! `eds2rust api`: the listing of the generated API, as the library gives it.
+
+mod common;
+
+use common::{example, run, seed, tempdir};
+
+#[test]
+fn api_lists_the_generated_api_or_errors() {
+    let linak = seed("linak_techline");
+    let (code, stdout, stderr) = run(&["api", &linak]);
+    assert_eq!(code, 0, "{stderr}");
+    let options = eds2rust::read::Options::default();
+    let library = eds2rust::r#gen::rust::api_listing_files(linak.as_ref(), &[], &options);
+    assert_eq!(
+        stdout,
+        library.expect("lists").text,
+        "the library's listing"
+    );
+    assert!(stdout.contains("\npdo::Tpdo1Feedback\t0x1A00\ttpdo 1\t8 bytes\tposition@0..16:"));
+
+    // An overlay changes the line of the entry it changes, and only that.
+    let dir = tempdir();
+    let overlay = dir.join("api_overlay.yaml");
+    std::fs::write(
+        &overlay,
+        "format: 1\nmodify:\n  - { index: 0x6060, access: ro }\n",
+    )
+    .unwrap();
+    let (_, before, _) = run(&["api", &example()]);
+    let (code, after, stderr) = run(&["api", "--overlay", overlay.to_str().unwrap(), &example()]);
+    assert_eq!(code, 0, "{stderr}");
+    let changed: Vec<_> = before
+        .lines()
+        .zip(after.lines())
+        .filter(|(a, b)| a != b)
+        .collect();
+    let line = "od::ModesOfOperation\t0x6060\ti8\t";
+    assert_eq!(
+        changed,
+        [(&*format!("{line}rw\t-\tpdo"), &*format!("{line}ro\t-\tpdo"))]
+    );
+
+    // Warnings on stderr and the listing on stdout; errors: exit 1, no listing.
+    let warn = dir.join("api_warn.eds");
+    std::fs::write(&warn, "[1000]\nParameterName=Device type\nDataType=0x0007\nAccessType=ro\nDefaultValue=017\nDefaultValue=0x10\n").unwrap();
+    let warn = warn.to_str().unwrap();
+    let listing = "od::DeviceType\t0x1000\tu32\tro\t-\t-\n";
+    let (code, stdout, stderr) = run(&["api", warn]);
+    assert_eq!((code, stdout.as_str()), (0, listing), "{stderr}");
+    assert!(stderr.contains("warning[eds::duplicate-key]"), "{stderr}");
+    let allow = [
+        "--allow",
+        "eds::duplicate-key",
+        "--allow",
+        "eds::unlisted-object",
+    ];
+    let (code, stdout, stderr) = run(&[&["api", "--strict"], &allow[..], &[warn]].concat());
+    assert_eq!((code, stdout.as_str(), stderr.as_str()), (0, listing, ""));
+    let bad = dir.join("api_bad.yaml");
+    std::fs::write(
+        &bad,
+        "format: 1\nobjects:\n  - { index: 0x2000, name: A, type: UINT16, access: rw }\n",
+    )
+    .unwrap();
+    let bad = bad.to_str().unwrap();
+    for args in [
+        vec!["api", "--strict", warn],
+        vec!["api", "--deny", "eds::duplicate-key", warn],
+        vec!["api", bad],
+        vec!["api", "--overlay", bad, &example()],
+    ] {
+        let (code, stdout, stderr) = run(&args);
+        assert_eq!((code, stdout.as_str()), (1, ""), "{args:?}: {stderr}");
+        assert!(stderr.contains("not listed: "), "{stderr}");
+    }
+    assert_eq!(run(&["api"]).0, 2, "no input is a usage error");
+    assert_eq!(run(&["api", "--allow", "eds::no-such-rule", warn]).0, 2);
+}
