@@ -276,7 +276,8 @@ fn input_errors_and_strict_warnings_are_returned() {
     let missing = api_listing_files(&dir.join("missing.eds"), &[], &Default::default());
     let _ = std::fs::remove_dir_all(&dir);
     let lenient = lenient.unwrap_or_else(|d| panic!("{}", d.render()));
-    assert_eq!(lenient.text, "od::X\t0x1000\tu32\tro\t-\t-\n");
+    // 0x1000 is named by CiA 301 (`DeviceType`), not by its `ParameterName`.
+    assert_eq!(lenient.text, "od::DeviceType\t0x1000\tu32\tro\t-\t-\n");
     assert!(
         lenient.warnings.warning_count() > 0,
         "the reader's warnings"

@@ -220,7 +220,7 @@ fn value_types(buf: &mut Buf) -> f64 {
     )
     .expect("fits");
 
-    let mode = ir::od::ModeOfOperationValue::from_raw(black_box(3));
+    let mode = ir::od::ModesOfOperationValue::from_raw(black_box(3));
     sum += mode.text().len() as f64;
     let velocity = ir::od::ProfileVelocityValue::from_value(black_box(1500.0)).expect("in range");
     sum += velocity.value();

@@ -249,7 +249,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Res<Summary> {
 
 /// The LSS address of the drive at node id 127, read by SDO (0x1018).
 fn read_address(m: &mut M, out: &mut dyn Write) -> Res<Identity> {
-    use od::identity_object as id;
+    use od::identity as id;
     let n = node(DEFAULT_NODE_ID)?;
     let address = Identity::new(
         read::<id::VendorId>(m, n)?,
@@ -271,12 +271,12 @@ fn scenario(m: &mut M, args: &Args, out: &mut dyn Write) -> Res<Summary> {
     let name = m
         .read_string::<od::ManufacturerDeviceName>(n)
         .map_err(|e| format!("node {NEW_NODE}: reading 0x1008: {e}"))?;
-    let sn = read::<od::identity_object::SerialNumber>(m, n)?;
+    let sn = read::<od::identity::SerialNumber>(m, n)?;
     writeln!(out, "node {NEW_NODE}: {name}, serial number {sn}")?;
     m.nmt(NmtCommand::Start, Some(n))?;
 
     writeln!(out, "CiA 402: profile velocity mode (0x6060 = 3)")?;
-    write::<od::ModeOfOperation>(m, n, od::ModeOfOperationValue::PROFILE_VELOCITY)?;
+    write::<od::ModesOfOperation>(m, n, od::ModesOfOperationValue::PROFILE_VELOCITY)?;
     write::<od::ProfileAcceleration>(m, n, od::ProfileAccelerationValue(RAMP_MM_S2))?;
     write::<od::ProfileDeceleration>(m, n, od::ProfileDecelerationValue(RAMP_MM_S2))?;
     let sw = read::<od::Statusword>(m, n)?.0;

@@ -117,6 +117,9 @@ fn corpus_files_against_themselves_and_mutations() {
         let with_default = device
             .objects
             .values()
+            // Not 0x1000: its default picks the device profile, and with it
+            // the canonical names of 0x6000–0x9FFF (docs/generated-code.md).
+            .filter(|o| o.index != 0x1000)
             .filter(|o| !is_mapping_object(o.index) && !pdo_object(o.index))
             .flat_map(|o| o.entries.values().map(move |e| (o.index, e)))
             .find(|(_, e)| {
@@ -152,8 +155,8 @@ fn corpus_files_against_themselves_and_mutations() {
             counts[2] += 1;
         }
 
-        // A standard object renamed: breaking when its Rust name changes,
-        // compatible when only the spelling of the source name does.
+        // A standard object renamed: compatible, however much the source name
+        // changes, since its Rust name is its canonical CiA name.
         if let Some(object) = [0x1018u16, 0x1000, 0x1001, 0x1017]
             .iter()
             .find_map(|i| device.objects.get(i))
@@ -166,7 +169,7 @@ fn corpus_files_against_themselves_and_mutations() {
             assert_eq!(c.len(), 1, "{name}: {c:#?}");
             assert_eq!(
                 (c[0].index, c[0].subindex, c[0].kind, c[0].severity),
-                (index, None, Kind::NameChanged, Severity::Breaking),
+                (index, None, Kind::NameChanged, Severity::Compatible),
                 "{name}"
             );
             let mut respelled = device.clone();

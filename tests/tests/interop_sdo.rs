@@ -12,7 +12,7 @@ use std::thread;
 use std::time::{Duration, Instant};
 
 use eds2rust_drivers::linak_techline::od::{
-    ManufacturerHardwareVersion, ProducerHeartbeatTime, ProducerHeartbeatTimeValue, identity_object,
+    ManufacturerHardwareVersion, ProducerHeartbeatTime, ProducerHeartbeatTimeValue, identity,
 };
 use eds2rust_runtime::blocking::{self, SdoClient};
 use eds2rust_runtime::od::{AccessRight, NodeId};
@@ -303,11 +303,8 @@ fn our_typed_access_to_python_node() {
         ours.read_string::<ManufacturerHardwareVersion>().unwrap(),
         "10LAXXCA-A-0"
     );
-    assert_eq!(ours.read::<identity_object::VendorId>().unwrap(), 0x0243);
-    assert_eq!(
-        ours.read::<identity_object::ProductCode>().unwrap(),
-        0x1234_5678
-    );
+    assert_eq!(ours.read::<identity::VendorId>().unwrap(), 0x0243);
+    assert_eq!(ours.read::<identity::ProductCode>().unwrap(), 0x1234_5678);
     ours.write::<ProducerHeartbeatTime>(ProducerHeartbeatTimeValue(1000))
         .unwrap();
     assert_eq!(python_value(ID, 0x1017, 0), vec![0xE8, 0x03]);

@@ -61,7 +61,7 @@ fn boots_answers_sdo_and_sends_its_tpdo() -> Result {
 
     // SDO reads and writes with the generated entry types.
     assert_eq!(
-        m.read::<od::identity_object::VendorId>(drive)?,
+        m.read::<od::identity::VendorId>(drive)?,
         conveyor::VENDOR_ID
     );
     assert_eq!(

@@ -332,9 +332,9 @@ impl Ec5000Bi {
     fn start(&mut self, ctx: &mut Context<'_, Ec5000BiEvent>) {
         let now = ctx.now();
         self.sm = DeviceStateMachine::new(now, sm_config());
-        let mode = ctx.get::<od::ModeOfOperation>().map_or(3, |m| m.to_raw());
+        let mode = ctx.get::<od::ModesOfOperation>().map_or(3, |m| m.to_raw());
         self.sm.set_mode(ModeOfOperation::from_i8(mode));
-        ctx.set::<od::ModeOfOperationDisplay>(od::ModeOfOperationDisplayValue(mode));
+        ctx.set::<od::ModesOfOperationDisplay>(od::ModesOfOperationDisplayValue(mode));
         self.last = now;
         self.v = 0.0;
         self.pos = 0.0;
@@ -510,7 +510,7 @@ impl Behaviour for Ec5000Bi {
         }
         // Reset communication sets 0x1000..0x1FFF back; the device's own
         // values are written again at every boot.
-        ctx.set::<od::identity_object::SerialNumber>(self.serial);
+        ctx.set::<od::identity::SerialNumber>(self.serial);
         if let Some(node) = ctx.node() {
             ctx.set::<od::bus_address::NodeIdActual>(node.get());
         }

@@ -388,9 +388,9 @@ impl LinakTechline {
         ctx.set::<cfg::SoftStopIn>(cfg::SoftStopInValue::from_raw(DEFAULT_RAMP_MS));
         ctx.set::<cfg::MaxSpeed>(cfg::MaxSpeedValue::from_raw(0xC8));
         ctx.set::<cfg::Uin>(SERIAL);
-        ctx.set::<od::identity_object::ProductCode>(IDENTITY.product_code);
-        ctx.set::<od::identity_object::RevisionNumber>(IDENTITY.revision);
-        ctx.set::<od::identity_object::SerialNumber>(IDENTITY.serial);
+        ctx.set::<od::identity::ProductCode>(IDENTITY.product_code);
+        ctx.set::<od::identity::RevisionNumber>(IDENTITY.revision);
+        ctx.set::<od::identity::SerialNumber>(IDENTITY.serial);
         // The command's settings start at "default" (0xFB), so that a
         // position written alone (SDO, p. 29) runs with the configuration.
         ctx.set::<cmd::CurrentLimit>(cmd::CurrentLimitValue::DEFAULT);

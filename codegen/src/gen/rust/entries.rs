@@ -107,6 +107,7 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
             },
             object.entries.len()
         ));
+        standard_para(cx, object, &mut doc);
         doc.origin(&object.origin);
         let doc = doc.tokens_with_alias(&object.name, &module.to_string());
         let index = super::prim::hex(u128::from(object.index));
@@ -177,7 +178,11 @@ fn entry_items(
     let mappable = entry.pdo_mappable;
     let fixed = Prim::of(entry.data_type).is_some();
     let mut out = TokenStream::new();
-    let doc = entry_doc(object, entry, var).tokens_with_alias(source_name, &ident.to_string());
+    let mut doc = entry_doc(object, entry, var);
+    if var {
+        standard_para(cx, object, &mut doc);
+    }
+    let doc = doc.tokens_with_alias(source_name, &ident.to_string());
     let derives = super::derives::attr(super::derives::ENTRY, false);
     out.extend(quote! {
         #doc
@@ -213,6 +218,16 @@ fn entry_items(
     };
     out.extend(values::emit(&mut vcx, entry, plan, names));
     out
+}
+
+/// For a standard object: where its Rust name comes from.
+fn standard_para(cx: &Ctx, object: &Object, doc: &mut Doc) {
+    if let Some(text) = crate::profiles::Canonical::of(cx.device).text(object.index) {
+        doc.para(format!(
+            "Standard object *{}*: named by its CiA name, whatever the source calls it.",
+            docs::text(&text)
+        ));
+    }
 }
 
 fn entry_doc(object: &Object, entry: &Entry, var: bool) -> Doc {

@@ -8,8 +8,13 @@
 //! together: names that become equal after sanitising are all qualified with
 //! their key (index, subindex, code) and reported as one diagnostic naming
 //! both origins, so that adding an object never silently renames another.
+//!
+//! A *fixed* request (a CiA canonical name, a `rust_name:` pin) is never
+//! qualified because of a source name; source names equal to a fixed name
+//! in the scope, or to a reserved canonical name of the device's profiles
+//! (present or not), are qualified with their own key.
 
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 
 use heck::{ToShoutySnakeCase, ToSnakeCase, ToUpperCamelCase};
 use proc_macro2::{Ident, Span};
@@ -156,6 +161,8 @@ struct Request {
     key: String,
     source: String,
     origin: Option<Origin>,
+    /// A canonical or pinned name: taken as it is.
+    fixed: bool,
 }
 
 /// One scope of generated names (a module, an enum's variants, a struct's
@@ -164,12 +171,17 @@ pub(crate) struct Namespace {
     scope: String,
     case: Case,
     reserved: Vec<String>,
+    /// Canonical names (UpperCamelCase) no source name may take.
+    canonical: Option<&'static HashSet<String>>,
     requests: Vec<Request>,
 }
 
 /// The resolved names of a [`Namespace`].
 pub(crate) struct Names {
     names: Vec<String>,
+    /// For a source name qualified because another source name in the scope
+    /// became the same: that shared name.
+    collided: Vec<Option<String>>,
 }
 
 impl Names {
@@ -180,6 +192,13 @@ impl Names {
     pub(crate) fn text(&self, id: NameId) -> &str {
         &self.names[id.0]
     }
+
+    /// The name `id` shares with another source name of the scope, when
+    /// that made it qualified (the only case in which removing another
+    /// object can change it).
+    pub(crate) fn collided(&self, id: NameId) -> Option<&str> {
+        self.collided[id.0].as_deref()
+    }
 }
 
 impl Namespace {
@@ -189,8 +208,16 @@ impl Namespace {
             scope: scope.into(),
             case,
             reserved: Vec::new(),
+            canonical: None,
             requests: Vec::new(),
         }
+    }
+
+    /// Reserves canonical names (UpperCamelCase, compared in this scope's
+    /// case): a source name equal to one is qualified with its key, whether
+    /// or not the object of that name exists.
+    pub(crate) fn reserve_canonical(&mut self, names: &'static HashSet<String>) {
+        self.canonical = Some(names);
     }
 
     /// Reserves the type names whose snake case is a constructor generated
@@ -217,6 +244,31 @@ impl Namespace {
             key: key.to_string(),
             source: source.to_string(),
             origin: origin.cloned(),
+            fixed: false,
+        });
+        NameId(self.requests.len() - 1)
+    }
+
+    /// Requests a fixed name (a canonical name, a pin): `name` is taken as
+    /// it is (sanitised into this scope's case); source names give way to
+    /// it. Two fixed names that meet are numbered and reported.
+    pub(crate) fn request_fixed(
+        &mut self,
+        name: &str,
+        key: &str,
+        origin: Option<&Origin>,
+    ) -> NameId {
+        let base = sanitize(name, self.case);
+        self.requests.push(Request {
+            base: if base.is_empty() {
+                sanitize(key, self.case)
+            } else {
+                base
+            },
+            key: key.to_string(),
+            source: name.to_string(),
+            origin: origin.cloned(),
+            fixed: true,
         });
         NameId(self.requests.len() - 1)
     }
@@ -232,19 +284,42 @@ impl Namespace {
             }
         }
         let qualified = |r: &Request| sanitize(&format!("{} {}", r.base, r.key), case);
+        // Collisions among source names; fixed names stand apart.
         let mut groups: BTreeMap<&str, Vec<usize>> = BTreeMap::new();
-        for (i, r) in self.requests.iter().enumerate() {
+        for (i, r) in self.requests.iter().enumerate().filter(|(_, r)| !r.fixed) {
             groups.entry(r.base.as_str()).or_default().push(i);
         }
+        let fixed: HashSet<&str> = self
+            .requests
+            .iter()
+            .filter(|r| r.fixed)
+            .map(|r| r.base.as_str())
+            .collect();
+        let canonical = |base: &str| {
+            self.canonical
+                .is_some_and(|set| set.contains(&sanitize(base, Case::UpperCamel)))
+        };
         let mut names: Vec<String> = Vec::with_capacity(self.requests.len());
+        let mut collided: Vec<Option<String>> = Vec::with_capacity(self.requests.len());
         for r in &self.requests {
-            let group = &groups[r.base.as_str()];
             let clash_reserved = self.reserved.contains(&r.base);
-            names.push(if group.len() > 1 || clash_reserved {
+            if r.fixed {
+                names.push(if clash_reserved {
+                    qualified(r)
+                } else {
+                    r.base.clone()
+                });
+                collided.push(None);
+                continue;
+            }
+            let group = &groups[r.base.as_str()];
+            let taken = clash_reserved || fixed.contains(r.base.as_str()) || canonical(&r.base);
+            names.push(if group.len() > 1 || taken {
                 qualified(r)
             } else {
                 r.base.clone()
             });
+            collided.push((group.len() > 1).then(|| r.base.clone()));
         }
         for (base, members) in &groups {
             let clash_reserved = self.reserved.iter().any(|n| n == base);
@@ -283,11 +358,14 @@ impl Namespace {
                     ),
                     Vec::new(),
                 ));
+                if collided[i].is_none() {
+                    collided[i] = Some(name.clone());
+                }
                 *name = new;
             }
             taken.push(name.clone());
         }
-        Names { names }
+        Names { names, collided }
     }
 }
 
@@ -326,7 +404,7 @@ fn report(
     diags.push(diagnostic(
         first.origin.as_ref(),
         format!(
-            "`{}` ({}) and {} all become `{base}` in {scope}; each is qualified with its key",
+            "`{}` ({}) and {} all become `{base}` in {scope}; each is qualified with its key (while the others exist: rename one in the source to make the names stable)",
             first.source,
             at(first.origin.as_ref()),
             others.join(" and "),

@@ -13,6 +13,7 @@ use super::naming::{Case, NameId, Names, Namespace};
 use super::values::{self, Plan};
 use crate::diag::Diagnostics;
 use crate::ir::{Device, Entry, Object, ObjectKind};
+use crate::profiles::Canonical;
 
 /// One entry's names: its zero-sized type and its value type's plan.
 pub(crate) struct EntryPlan<'d> {
@@ -31,6 +32,9 @@ pub(crate) struct RootPlan<'d> {
 pub(crate) struct ModulePlan<'d> {
     pub(crate) object: &'d Object,
     pub(crate) module: Ident,
+    /// The module name shared with another source name, when that made it
+    /// qualified.
+    pub(crate) module_collided: Option<String>,
     pub(crate) entries: Vec<EntryPlan<'d>>,
     /// The names of the module's scope.
     pub(crate) names: Names,
@@ -65,35 +69,50 @@ pub(crate) fn plan<'d>(
         .filter(|o| !o.entries.is_empty())
         .collect();
     let is_var = |o: &Object| matches!(o.kind, ObjectKind::Var | ObjectKind::Domain);
+    let canonical = Canonical::of(device);
     // Names in `od`: types of VAR objects (and their value types), modules of
-    // the others.
+    // the others. Standard objects take their canonical name; no vendor
+    // name may take one of those.
     let mut types = Namespace::new("module `od`", Case::UpperCamel);
     types.reserve_constructor_names();
+    types.reserve_canonical(canonical.reserved());
     let mut modules = Namespace::new("module `od`", Case::Snake);
+    modules.reserve_canonical(canonical.reserved());
     let mut root = Vec::new();
     let mut module_ids = Vec::new();
     for object in objects {
         let key = format!("x{:04X}", object.index);
+        let fixed = canonical.object(object.index);
         if is_var(object) {
             let entry = object.entries.values().next().expect("non-empty");
-            let zst = types.request(&object.name, &key, Some(&object.origin));
-            let value = values::plan(entry, error_plan(device, errors, entry), &mut types);
+            let (zst, name) = match &fixed {
+                Some(name) => (
+                    types.request_fixed(name, &key, Some(&object.origin)),
+                    values::Name::Fixed(name),
+                ),
+                None => (
+                    types.request(&object.name, &key, Some(&object.origin)),
+                    values::Name::Source(&entry.name),
+                ),
+            };
+            let value = values::plan(entry, name, error_plan(device, errors, entry), &mut types);
             root.push(RootPlan {
                 object,
                 entry: EntryPlan { entry, zst, value },
             });
         } else {
-            module_ids.push((
-                object,
-                modules.request(&object.name, &key, Some(&object.origin)),
-            ));
+            let id = match &fixed {
+                Some(name) => modules.request_fixed(name, &key, Some(&object.origin)),
+                None => modules.request(&object.name, &key, Some(&object.origin)),
+            };
+            module_ids.push((object, id, fixed.is_some()));
         }
     }
     let root_names = types.resolve(diags);
     let module_names = modules.resolve(diags);
     let modules = module_ids
         .into_iter()
-        .map(|(object, id)| {
+        .map(|(object, id, standard)| {
             let module = module_names.get(id);
             let mut ns = Namespace::new(format!("module `od::{module}`"), Case::UpperCamel);
             ns.reserve_constructor_names();
@@ -101,12 +120,22 @@ pub(crate) fn plan<'d>(
                 .entries
                 .values()
                 .map(|entry| {
-                    let zst = ns.request(
-                        &entry.name,
-                        &format!("sub {}", entry.subindex),
-                        Some(&entry.origin),
-                    );
-                    let value = values::plan(entry, error_plan(device, errors, entry), &mut ns);
+                    let key = format!("sub {}", entry.subindex);
+                    let fixed = standard
+                        .then(|| canonical.sub(object.index, entry.subindex))
+                        .flatten();
+                    let (zst, name) = match &fixed {
+                        Some(name) => (
+                            ns.request_fixed(name, &key, Some(&entry.origin)),
+                            values::Name::Fixed(name),
+                        ),
+                        None => (
+                            ns.request(&entry.name, &key, Some(&entry.origin)),
+                            values::Name::Source(&entry.name),
+                        ),
+                    };
+                    let value =
+                        values::plan(entry, name, error_plan(device, errors, entry), &mut ns);
                     EntryPlan { entry, zst, value }
                 })
                 .collect();
@@ -115,6 +144,7 @@ pub(crate) fn plan<'d>(
             ModulePlan {
                 object,
                 module,
+                module_collided: module_names.collided(id).map(str::to_string),
                 entries,
                 names,
             }
@@ -159,6 +189,11 @@ pub(crate) struct DeviceNames {
     pub(crate) modules: BTreeMap<u16, String>,
     /// By error table name: its enum (`errors::LinakErrors`).
     pub(crate) error_tables: BTreeMap<String, String>,
+    /// By (index, subindex): the names in `od` (its type, value type or
+    /// module) that were qualified because another source name in `od`
+    /// became the same; only an object sharing one of them can change the
+    /// entry's path by going away.
+    pub(crate) collided: BTreeMap<(u16, u8), Vec<String>>,
 }
 
 /// The names of every generated entry of `device`, from the same plan the
@@ -173,6 +208,14 @@ pub(crate) fn device_names(device: &Device) -> DeviceNames {
     let mut out = DeviceNames::default();
     for root in &od.root {
         let e = &root.entry;
+        let shared: Vec<String> = std::iter::once(e.zst)
+            .chain(e.value.names())
+            .filter_map(|id| od.root_names.collided(id).map(str::to_string))
+            .collect();
+        if !shared.is_empty() {
+            out.collided
+                .insert((root.object.index, e.entry.subindex), shared);
+        }
         out.entries.insert(
             (root.object.index, e.entry.subindex),
             (
@@ -184,6 +227,10 @@ pub(crate) fn device_names(device: &Device) -> DeviceNames {
     for m in &od.modules {
         let module = format!("od::{}", m.module);
         for e in &m.entries {
+            if let Some(shared) = m.module_collided.as_ref() {
+                out.collided
+                    .insert((m.object.index, e.entry.subindex), vec![shared.clone()]);
+            }
             out.entries.insert(
                 (m.object.index, e.entry.subindex),
                 (
@@ -202,3 +249,6 @@ pub(crate) fn device_names(device: &Device) -> DeviceNames {
     }
     out
 }
+
+#[cfg(test)]
+mod tests;

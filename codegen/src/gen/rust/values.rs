@@ -43,20 +43,59 @@ pub(crate) enum Plan {
     Scaled { name: NameId, raw: Prim },
 }
 
+impl Plan {
+    /// Every name the plan requested in the entry's scope.
+    pub(crate) fn names(&self) -> Vec<NameId> {
+        match self {
+            Plan::Prim(_) | Plan::Bytes(_) | Plan::Error(_) => Vec::new(),
+            Plan::Enum {
+                name, kind, number, ..
+            } => [Some(*name), Some(*kind), *number]
+                .into_iter()
+                .flatten()
+                .collect(),
+            Plan::Bits {
+                name,
+                fields,
+                state,
+                ..
+            } => std::iter::once(*name)
+                .chain(fields.iter().flatten().copied())
+                .chain(*state)
+                .collect(),
+            Plan::Scaled { name, .. } => vec![*name],
+        }
+    }
+}
+
+/// What an entry's value type names are made of: its source name, or a
+/// fixed name (canonical or pinned) that they follow, fixed too.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Name<'a> {
+    Source(&'a str),
+    Fixed(&'a str),
+}
+
 /// Chooses the value type of `entry` and requests its names in `ns` (the
 /// namespace of the module the entry's zero-sized type lives in).
-pub(crate) fn plan(entry: &Entry, error_plan: Option<usize>, ns: &mut Namespace) -> Plan {
+pub(crate) fn plan(
+    entry: &Entry,
+    name: Name<'_>,
+    error_plan: Option<usize>,
+    ns: &mut Namespace,
+) -> Plan {
     let Some(raw) = Prim::of(entry.data_type) else {
         return Plan::Bytes(bytes_marker(entry));
     };
     let s = &entry.semantics;
     let key = format!("sub {}", entry.subindex);
-    let req = |ns: &mut Namespace, suffix: &str| {
-        ns.request(
-            &format!("{} {suffix}", entry.name),
-            &key,
-            Some(&entry.origin),
-        )
+    let req = |ns: &mut Namespace, suffix: &str| match name {
+        Name::Source(source) => {
+            ns.request(&format!("{source} {suffix}"), &key, Some(&entry.origin))
+        }
+        Name::Fixed(fixed) => {
+            ns.request_fixed(&format!("{fixed} {suffix}"), &key, Some(&entry.origin))
+        }
     };
     if raw.is_integer() {
         if let Some(index) = error_plan {

@@ -70,7 +70,7 @@ impl Ec5000Bi {
     }
 
     pub(crate) fn mode_written(&mut self, ctx: Ctx<'_, '_>) {
-        let raw = ctx.get::<od::ModeOfOperation>().map_or(3, |m| m.to_raw());
+        let raw = ctx.get::<od::ModesOfOperation>().map_or(3, |m| m.to_raw());
         let mode = ModeOfOperation::from_i8(raw);
         if mode == self.sm.mode() {
             return;
@@ -78,7 +78,7 @@ impl Ec5000Bi {
         self.sm.set_mode(mode);
         self.sm.set_target_reached(false);
         self.pp = physics::Positioning::default();
-        ctx.set::<od::ModeOfOperationDisplay>(od::ModeOfOperationDisplayValue(raw));
+        ctx.set::<od::ModesOfOperationDisplay>(od::ModesOfOperationDisplayValue(raw));
         ctx.emit(Ec5000BiEvent::ModeChanged(mode));
         self.publish(ctx);
     }
@@ -276,7 +276,7 @@ impl Ec5000Bi {
                 .map_or(0, |r| r.to_raw()),
         );
         let gear = ctx
-            .get::<od::gear_ratio::MotorShaftRevolutions>()
+            .get::<od::gear_ratio::MotorRevolutions>()
             .map_or(18.0, f64::from);
         let feed = ctx
             .get::<od::feed_constant::Feed>()

@@ -87,7 +87,7 @@ pub(crate) fn apply<E>(ctx: &mut Context<'_, E>, variant: Variant) {
     ctx.set::<od::ProfileDeceleration>(od::ProfileDecelerationValue(PROFILE_RAMP));
     ctx.set::<od::FollowingErrorWindow>(od::FollowingErrorWindowValue(FOLLOWING_ERROR_WINDOW));
     ctx.set::<od::FollowingErrorTimeOut>(od::FollowingErrorTimeOutValue(FOLLOWING_ERROR_TIMEOUT));
-    ctx.set::<od::PositionWindow>(od::PositionWindowValue(POSITION_WINDOW));
+    ctx.set::<od::PositionWindowX21F1>(od::PositionWindowValue(POSITION_WINDOW));
     // CiA 402 defaults of the option codes (the manual gives none).
     ctx.set::<od::QuickStopOptionCode>(od::QuickStopOptionCodeValue::QUICK_STOP_RAMP_AND_DISABLE);
     ctx.set::<od::HaltOptionCode>(od::HaltOptionCodeValue::SLOW_DOWN_RAMP);

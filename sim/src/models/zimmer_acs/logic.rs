@@ -487,7 +487,7 @@ impl ZimmerAcs {
         let pp = self.state() == Some(State::OperationEnabled)
             && self.mode() == ModeOfOperation::ProfilePosition;
         let halt = self.sm.as_ref().is_some_and(|sm| sm.controlword().halt());
-        let window = f64::from(ctx.get::<od::PositionWindow>().map_or(0, |v| v.0));
+        let window = f64::from(ctx.get::<od::PositionWindowX21F1>().map_or(0, |v| v.0));
         let settled = self.profiler.at_rest()
             && self.pending.is_none()
             && (halt

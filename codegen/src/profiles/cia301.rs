@@ -1,0 +1,204 @@
+//! CiA 301 (CANopen application layer and communication profile): the
+//! communication objects every device may have, 0x1000–0x1FFF.
+
+use super::{NumberedRange, StdName, obj, sub};
+
+/// Objects with one fixed index, and their standard sub-entries.
+pub(super) const OBJECTS: &[StdName] = &[
+    obj(0x1000, "DeviceType", "Device type"),
+    obj(0x1001, "ErrorRegister", "Error register"),
+    obj(
+        0x1002,
+        "ManufacturerStatusRegister",
+        "Manufacturer status register",
+    ),
+    obj(0x1003, "PreDefinedErrorField", "Pre-defined error field"),
+    sub(0x1003, 0, "NumberOfErrors", "Number of errors"),
+    obj(0x1005, "CobIdSync", "COB-ID SYNC message"),
+    obj(
+        0x1006,
+        "CommunicationCyclePeriod",
+        "Communication cycle period",
+    ),
+    obj(
+        0x1007,
+        "SynchronousWindowLength",
+        "Synchronous window length",
+    ),
+    obj(0x1008, "ManufacturerDeviceName", "Manufacturer device name"),
+    obj(
+        0x1009,
+        "ManufacturerHardwareVersion",
+        "Manufacturer hardware version",
+    ),
+    obj(
+        0x100A,
+        "ManufacturerSoftwareVersion",
+        "Manufacturer software version",
+    ),
+    obj(0x100C, "GuardTime", "Guard time"),
+    obj(0x100D, "LifeTimeFactor", "Life time factor"),
+    obj(0x1010, "StoreParameters", "Store parameters"),
+    sub(0x1010, 1, "SaveAllParameters", "Save all parameters"),
+    sub(
+        0x1010,
+        2,
+        "SaveCommunicationParameters",
+        "Save communication parameters",
+    ),
+    sub(
+        0x1010,
+        3,
+        "SaveApplicationParameters",
+        "Save application parameters",
+    ),
+    obj(
+        0x1011,
+        "RestoreDefaultParameters",
+        "Restore default parameters",
+    ),
+    sub(
+        0x1011,
+        1,
+        "RestoreAllDefaultParameters",
+        "Restore all default parameters",
+    ),
+    sub(
+        0x1011,
+        2,
+        "RestoreCommunicationDefaultParameters",
+        "Restore communication default parameters",
+    ),
+    sub(
+        0x1011,
+        3,
+        "RestoreApplicationDefaultParameters",
+        "Restore application default parameters",
+    ),
+    obj(0x1012, "CobIdTime", "COB-ID TIME"),
+    obj(
+        0x1013,
+        "HighResolutionTimeStamp",
+        "High resolution time stamp",
+    ),
+    obj(0x1014, "CobIdEmcy", "COB-ID EMCY"),
+    obj(0x1015, "InhibitTimeEmcy", "Inhibit time EMCY"),
+    obj(0x1016, "ConsumerHeartbeatTime", "Consumer heartbeat time"),
+    obj(0x1017, "ProducerHeartbeatTime", "Producer heartbeat time"),
+    obj(0x1018, "Identity", "Identity object"),
+    sub(0x1018, 1, "VendorId", "Vendor-ID"),
+    sub(0x1018, 2, "ProductCode", "Product code"),
+    sub(0x1018, 3, "RevisionNumber", "Revision number"),
+    sub(0x1018, 4, "SerialNumber", "Serial number"),
+    obj(
+        0x1019,
+        "SynchronousCounterOverflowValue",
+        "Synchronous counter overflow value",
+    ),
+    obj(0x1020, "VerifyConfiguration", "Verify configuration"),
+    sub(0x1020, 1, "ConfigurationDate", "Configuration date"),
+    sub(0x1020, 2, "ConfigurationTime", "Configuration time"),
+    obj(0x1021, "StoreEds", "Store EDS"),
+    obj(0x1022, "StoreFormat", "Store format"),
+    obj(0x1023, "OsCommand", "OS command"),
+    obj(0x1024, "OsCommandMode", "OS command mode"),
+    obj(0x1025, "OsDebuggerInterface", "OS debugger interface"),
+    obj(0x1026, "OsPrompt", "OS prompt"),
+    obj(0x1027, "ModuleList", "Module list"),
+    obj(0x1028, "EmergencyConsumer", "Emergency consumer object"),
+    obj(0x1029, "ErrorBehavior", "Error behavior object"),
+    // The default SDO server; the further ones are numbered below.
+    obj(0x1200, "SdoServerParameter", "SDO server parameter"),
+    sub(
+        0x1200,
+        1,
+        "CobIdClientToServer",
+        "COB-ID client to server (rx)",
+    ),
+    sub(
+        0x1200,
+        2,
+        "CobIdServerToClient",
+        "COB-ID server to client (tx)",
+    ),
+];
+
+const SDO_SERVER_SUBS: &[(u8, &str, &str)] = &[
+    (1, "CobIdClientToServer", "COB-ID client to server (rx)"),
+    (2, "CobIdServerToClient", "COB-ID server to client (tx)"),
+    (3, "NodeIdOfSdoClient", "Node-ID of the SDO client"),
+];
+
+const SDO_CLIENT_SUBS: &[(u8, &str, &str)] = &[
+    (1, "CobIdClientToServer", "COB-ID client to server (tx)"),
+    (2, "CobIdServerToClient", "COB-ID server to client (rx)"),
+    (3, "NodeIdOfSdoServer", "Node-ID of the SDO server"),
+];
+
+const RPDO_COMM_SUBS: &[(u8, &str, &str)] = &[
+    (1, "CobIdUsedByRpdo", "COB-ID used by RPDO"),
+    (2, "TransmissionType", "Transmission type"),
+    (3, "InhibitTime", "Inhibit time"),
+    (5, "EventTimer", "Event-timer"),
+];
+
+const TPDO_COMM_SUBS: &[(u8, &str, &str)] = &[
+    (1, "CobIdUsedByTpdo", "COB-ID used by TPDO"),
+    (2, "TransmissionType", "Transmission type"),
+    (3, "InhibitTime", "Inhibit time"),
+    (5, "EventTimer", "Event-timer"),
+    (6, "SyncStartValue", "SYNC start value"),
+];
+
+/// The numbered communication objects: `{n}` is 1 for the range's first
+/// index (`first_number` for the SDO servers, whose first is 0x1200 above).
+pub(super) const RANGES: &[NumberedRange] = &[
+    NumberedRange {
+        first: 0x1201,
+        last: 0x127F,
+        first_number: 2,
+        name: ("SdoServer", "Parameter"),
+        text: "SDO server parameter",
+        subs: SDO_SERVER_SUBS,
+    },
+    NumberedRange {
+        first: 0x1280,
+        last: 0x12FF,
+        first_number: 1,
+        name: ("SdoClient", "Parameter"),
+        text: "SDO client parameter",
+        subs: SDO_CLIENT_SUBS,
+    },
+    NumberedRange {
+        first: 0x1400,
+        last: 0x15FF,
+        first_number: 1,
+        name: ("Rpdo", "CommunicationParameter"),
+        text: "RPDO communication parameter",
+        subs: RPDO_COMM_SUBS,
+    },
+    NumberedRange {
+        first: 0x1600,
+        last: 0x17FF,
+        first_number: 1,
+        name: ("Rpdo", "MappingParameter"),
+        text: "RPDO mapping parameter",
+        subs: &[],
+    },
+    NumberedRange {
+        first: 0x1800,
+        last: 0x19FF,
+        first_number: 1,
+        name: ("Tpdo", "CommunicationParameter"),
+        text: "TPDO communication parameter",
+        subs: TPDO_COMM_SUBS,
+    },
+    NumberedRange {
+        first: 0x1A00,
+        last: 0x1BFF,
+        first_number: 1,
+        name: ("Tpdo", "MappingParameter"),
+        text: "TPDO mapping parameter",
+        subs: &[],
+    },
+];
