@@ -42,6 +42,10 @@ const HOSTILE: &str = "codegen/tests/fixtures/hostile.eds";
 /// compiled with the rest, it shows those names cannot shadow them.
 const SHADOWING: &str = "codegen/tests/fixtures/shadowing.yaml";
 
+/// A YAML table whose objects, subs, bit fields and named values have
+/// `rust_name:` pins: compiled with the rest.
+const PINNED: &str = "codegen/tests/fixtures/rust_name.yaml";
+
 /// Corpus files (../shared/eds-corpus/files) whose generated code is
 /// snapshotted, chosen for variety.
 const CORPUS_SNAPSHOTS: &[&str] = &[
@@ -336,7 +340,7 @@ fn clippy(dir: &Path) -> Result<(), String> {
     Ok(())
 }
 
-/// Every corpus file, the seeds and the hostile and shadowing fixtures compile
+/// Every corpus file, the seeds and the hostile, shadowing and pinned fixtures compile
 /// together, clippy-clean. Without ../shared the seeds and the fixtures still do.
 #[test]
 fn generated_code_compiles_under_clippy() {
@@ -352,6 +356,7 @@ fn generated_code_compiles_under_clippy() {
         .collect();
     inputs.push((HOSTILE.to_string(), workspace_root().join(HOSTILE)));
     inputs.push((SHADOWING.to_string(), workspace_root().join(SHADOWING)));
+    inputs.push((PINNED.to_string(), workspace_root().join(PINNED)));
     let own = inputs.len();
     if let Some(files) = corpus_files(
         "generated-code compile check of the corpus (the seeds and the fixtures still ran)",

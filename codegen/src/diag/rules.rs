@@ -140,6 +140,10 @@ pub const RULES: &[Rule] = &[
         "a runtime path that is not a Rust path",
     ),
     rule(
+        "gen::rust-name-collision",
+        "a `rust_name:` pin equal to another name in its scope",
+    ),
+    rule(
         "table::array-type",
         "an ARRAY whose subs do not share one type",
     ),
@@ -225,6 +229,10 @@ pub const RULES: &[Rule] = &[
         "a PDO communication parameter that cannot be used",
     ),
     rule("table::pdo-too-long", "a PDO mapping of more than 64 bits"),
+    rule(
+        "table::rust-name",
+        "a `rust_name:` that is not an identifier of the case needed",
+    ),
     rule(
         "table::semantics-type",
         "semantics that do not fit the entry's type",

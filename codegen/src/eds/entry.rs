@@ -178,6 +178,7 @@ impl Lowering<'_> {
             obj_flags,
             denotation,
             semantics: Default::default(),
+            rust_name: None,
             origin: Origin {
                 file: self.doc.file.clone(),
                 line: section.line,

@@ -135,6 +135,7 @@ impl Lowering<'_> {
             obj_flags,
             denotation,
             compact_sub_obj: compact,
+            rust_name: None,
             origin: self.origin(section.line),
         })
     }

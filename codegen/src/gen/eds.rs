@@ -447,6 +447,7 @@ mod tests {
             obj_flags: None,
             denotation: None,
             semantics: Default::default(),
+            rust_name: None,
             origin: Origin::default(),
         }
     }
@@ -467,6 +468,7 @@ mod tests {
             obj_flags: Some(1),
             denotation: None,
             compact_sub_obj: None,
+            rust_name: None,
             origin: Origin::default(),
         };
         array
@@ -516,6 +518,7 @@ mod tests {
             obj_flags: None,
             denotation: Some("\r".into()),
             compact_sub_obj: Some(3),
+            rust_name: None,
             origin: Origin::default(),
         };
         let mut e = entry(0, DataType::Other(0xFFFF), Some(Value::Integer(i128::MIN)));

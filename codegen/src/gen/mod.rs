@@ -123,6 +123,7 @@ mod tests {
             obj_flags: None,
             denotation: None,
             semantics: Default::default(),
+            rust_name: None,
             origin: Origin {
                 file: format!("{index:x}"),
                 line: 0,
@@ -137,6 +138,7 @@ mod tests {
             obj_flags: None,
             denotation: None,
             compact_sub_obj: None,
+            rust_name: None,
             origin: Origin::default(),
         };
         identity

@@ -183,6 +183,11 @@ pub struct Object {
     pub denotation: Option<String>,
     /// Set when the sub-entries were expanded from `CompactSubObj`.
     pub compact_sub_obj: Option<u8>,
+    /// The Rust module name pinned for an ARRAY/RECORD object (YAML
+    /// `rust_name:`), snake_case; it wins over the canonical and the source
+    /// name. A VAR object's pin is its entry's [`Entry::rust_name`].
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rust_name: Option<String>,
     pub origin: Origin,
 }
 
@@ -239,6 +244,10 @@ pub struct Entry {
     /// What the raw value means (YAML only).
     #[serde(default, skip_serializing_if = "Semantics::is_empty")]
     pub semantics: Semantics,
+    /// The Rust type name pinned for this entry (YAML `rust_name:`),
+    /// UpperCamelCase; it wins over the canonical and the source name.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rust_name: Option<String>,
     pub origin: Origin,
 }
 
@@ -263,6 +272,7 @@ impl Entry {
             obj_flags: None,
             denotation: None,
             semantics: Semantics::default(),
+            rust_name: None,
             origin,
         }
     }

@@ -52,6 +52,10 @@ pub struct NamedValue {
     pub high: i128,
     pub name: String,
     pub text: Option<String>,
+    /// The enum variant name pinned for this value (YAML `rust_name:`),
+    /// UpperCamelCase.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rust_name: Option<String>,
     pub origin: Origin,
 }
 
@@ -71,6 +75,9 @@ pub struct BitField {
     pub unit: Option<String>,
     pub scale: Option<f64>,
     pub values: Option<ValueTable>,
+    /// The getter name pinned for this field (YAML `rust_name:`), snake_case.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rust_name: Option<String>,
     pub origin: Origin,
 }
 

@@ -8,6 +8,7 @@ use serde_saphyr::Spanned;
 use super::schema::{EntryDef, KindDef, Text};
 use super::{At, Ctx, place};
 use crate::eds::number;
+use crate::r#gen::rust::naming::{Case, sanitize};
 use crate::ir::{Access, DataType, Device, Entry, Literal, Object, ObjectKind, Value};
 
 /// Semantic keys, allowed wherever an entry's meaning may be given.
@@ -51,6 +52,7 @@ pub(super) fn present_keys(def: &Spanned<EntryDef>) -> Vec<(&'static str, At)> {
     put("bits", d.bits.as_ref().map(|_| whole));
     put("patterns", d.patterns.as_ref().map(|_| whole));
     put("error_table", d.error_table.as_ref().map(At::of));
+    put("rust_name", d.rust_name.as_ref().map(At::of));
     keys
 }
 
@@ -153,7 +155,7 @@ pub(super) fn add(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>) {
                 ctx,
                 def,
                 &[
-                    &["index", "name", "kind", "description"],
+                    &["index", "name", "kind", "description", "rust_name"],
                     VALUE_KEYS,
                     SEMANTIC_KEYS,
                 ],
@@ -169,7 +171,7 @@ pub(super) fn add(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>) {
             reject_keys(
                 ctx,
                 def,
-                &[&["index", "name", "kind", "description", "subs"]],
+                &[&["index", "name", "kind", "description", "subs", "rust_name"]],
                 "on an array or record object (give it on its sub-entries)",
                 &here,
             );
@@ -182,6 +184,12 @@ pub(super) fn add(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>) {
             object_kind
         }
     };
+    let object_rust_name = match object_kind {
+        ObjectKind::Array | ObjectKind::Record => {
+            rust_name(ctx, &def.value.rust_name, Case::Snake, &here)
+        }
+        _ => None,
+    };
     device.objects.insert(
         index,
         Object {
@@ -192,6 +200,7 @@ pub(super) fn add(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>) {
             obj_flags: None,
             denotation: None,
             compact_sub_obj: None,
+            rust_name: object_rust_name,
             origin: ctx.origin(At::of(def)),
         },
     );
@@ -248,7 +257,11 @@ fn build_subs(
         reject_keys(
             ctx,
             sub_def,
-            &[&["sub", "name", "description"], VALUE_KEYS, SEMANTIC_KEYS],
+            &[
+                &["sub", "name", "description", "rust_name"],
+                VALUE_KEYS,
+                SEMANTIC_KEYS,
+            ],
             "on a sub-entry",
             &here,
         );
@@ -351,6 +364,7 @@ fn build_entry(
         obj_flags: None,
         denotation: None,
         semantics: Default::default(),
+        rust_name: rust_name(ctx, &d.rust_name, Case::UpperCamel, here),
         origin: ctx.origin(At::of(def)),
     };
     check_limits(ctx, &entry, def, here);
@@ -568,16 +582,26 @@ pub(super) fn modify(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>
         ctx,
         def,
         "a `modify` item",
-        &[&["index", "sub", "name", "description"], VALUE_KEYS],
+        &[
+            &["index", "sub", "name", "description", "rust_name"],
+            VALUE_KEYS,
+        ],
         "in `modify` (meaning goes to `semantics`)",
     ) else {
         return;
     };
+    let object_pinned = pin_object(ctx, device, def, index);
+    if object_pinned && only_pin(def) {
+        return;
+    }
     let Some(entry) = find_entry(ctx, device, index, sub, At::of(def)) else {
         return;
     };
     let mut entry = entry.clone();
     let d = &def.value;
+    if d.rust_name.is_some() && !object_pinned {
+        entry.rust_name = rust_name(ctx, &d.rust_name, Case::UpperCamel, &here);
+    }
     if let Some(name) = &d.name {
         entry.name = name.value.clone();
     }
@@ -654,4 +678,73 @@ pub(super) fn find_entry<'d>(
             entry
         }
     }
+}
+
+/// A `rust_name:` pin, checked to be an identifier of `case` already: a
+/// `table::rust-name` error suggesting the converted form when it is not.
+pub(super) fn rust_name(
+    ctx: &mut Ctx,
+    text: &Option<Text>,
+    case: Case,
+    here: &str,
+) -> Option<String> {
+    let text = text.as_ref()?;
+    let pin = text.value.as_str();
+    let converted = sanitize(pin, case);
+    if converted == pin {
+        return Some(pin.to_string());
+    }
+    let (case_name, what) = match case {
+        Case::UpperCamel => ("UpperCamelCase", "a type or enum variant"),
+        Case::Snake => ("snake_case", "a module or method"),
+        Case::ShoutySnake => ("SHOUTY_SNAKE_CASE", "a constant"),
+    };
+    let suggestion = if converted.is_empty() {
+        "it has nothing usable as an identifier".to_string()
+    } else {
+        format!("write `{converted}`")
+    };
+    ctx.error(
+        "table::rust-name",
+        At::of(text),
+        here,
+        "rust_name",
+        format!(
+            "`rust_name: {pin}` is not a valid {case_name} Rust identifier, which {what} needs; {suggestion}"
+        ),
+    );
+    None
+}
+
+/// A `rust_name:` of a `modify:` or `semantics:` item without `sub` that
+/// names an ARRAY or RECORD object pins the object's module name; true when
+/// the item did that (its other keys still apply to sub 0).
+pub(super) fn pin_object(
+    ctx: &mut Ctx,
+    device: &mut Device,
+    def: &Spanned<EntryDef>,
+    index: u16,
+) -> bool {
+    let d = &def.value;
+    if d.rust_name.is_none() || d.sub.is_some() {
+        return false;
+    }
+    let Some(object) = device.objects.get(&index) else {
+        return false;
+    };
+    if !matches!(object.kind, ObjectKind::Array | ObjectKind::Record) {
+        return false;
+    }
+    let pin = rust_name(ctx, &d.rust_name, Case::Snake, &place(index, None));
+    if let Some(object) = device.objects.get_mut(&index) {
+        object.rust_name = pin;
+    }
+    true
+}
+
+/// Whether an item gives nothing but `index` and `rust_name`.
+pub(super) fn only_pin(def: &Spanned<EntryDef>) -> bool {
+    present_keys(def)
+        .iter()
+        .all(|(key, _)| matches!(*key, "index" | "rust_name"))
 }

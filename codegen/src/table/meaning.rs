@@ -6,9 +6,12 @@ use std::collections::BTreeMap;
 
 use serde_saphyr::Spanned;
 
-use super::entry::{SEMANTIC_KEYS, entry_reference, find_entry, integer};
+use super::entry::{
+    SEMANTIC_KEYS, entry_reference, find_entry, integer, only_pin, pin_object, rust_name,
+};
 use super::schema::{BitDef, EntryDef, PatternDef, Text, ValuesDef};
 use super::{At, Ctx, place};
+use crate::r#gen::rust::naming::Case;
 use crate::ir::{
     BitField, DataType, Device, Entry, NamedValue, Pattern, Semantics, ValueKind, ValueTable,
 };
@@ -220,6 +223,7 @@ fn value_table(
             high: range.1,
             name: n.name.value.clone(),
             text: n.text.as_ref().map(|t| t.value.clone()),
+            rust_name: rust_name(ctx, &n.rust_name, Case::UpperCamel, here),
             origin: ctx.origin(at),
         });
     }
@@ -326,6 +330,7 @@ fn bit_fields(ctx: &mut Ctx, defs: &[Spanned<BitDef>], width: u32, here: &str) -
             unit: d.unit.as_ref().map(|t| t.value.clone()),
             scale: d.scale.as_ref().map(|s| s.value),
             values,
+            rust_name: rust_name(ctx, &d.rust_name, Case::Snake, here),
             origin: ctx.origin(at),
         });
     }
@@ -407,15 +412,21 @@ pub(super) fn apply_list_item(ctx: &mut Ctx, device: &mut Device, def: &Spanned<
         ctx,
         def,
         "a `semantics` item",
-        &[&["index", "sub", "description"], SEMANTIC_KEYS],
+        &[&["index", "sub", "description", "rust_name"], SEMANTIC_KEYS],
         "in `semantics` (values and access go to `modify` or `objects`)",
     ) else {
         return;
     };
+    let object_pinned = pin_object(ctx, device, def, index);
+    if object_pinned && only_pin(def) {
+        return;
+    }
     let Some(entry) = find_entry(ctx, device, index, sub, At::of(def)) else {
         return;
     };
     let (mut semantics, data_type) = (entry.semantics.clone(), entry.data_type);
+    let pin = (def.value.rust_name.is_some() && !object_pinned)
+        .then(|| rust_name(ctx, &def.value.rust_name, Case::UpperCamel, &here));
     merge(ctx, &mut semantics, def, data_type, &here);
     if let Some(entry) = device
         .objects
@@ -423,6 +434,9 @@ pub(super) fn apply_list_item(ctx: &mut Ctx, device: &mut Device, def: &Spanned<
         .and_then(|o| o.entries.get_mut(&sub))
     {
         entry.semantics = semantics;
+        if let Some(pin) = pin {
+            entry.rust_name = pin;
+        }
     }
 }
 

@@ -91,6 +91,7 @@ fn new_entry(sub: u8, name: &str, data_type: DataType, default: Literal, origin:
         obj_flags: None,
         denotation: None,
         semantics: Default::default(),
+        rust_name: None,
         origin: origin.clone(),
     }
 }
@@ -249,6 +250,7 @@ fn record(index: u16, name: String, entries: BTreeMap<u8, Entry>, origin: Origin
         obj_flags: None,
         denotation: None,
         compact_sub_obj: None,
+        rust_name: None,
         origin,
     }
 }

@@ -139,6 +139,9 @@ pub struct EntryDef {
     pub bits: Option<Vec<Spanned<BitDef>>>,
     pub patterns: Option<Vec<Spanned<PatternDef>>>,
     pub error_table: Option<Text>,
+    /// Pins the Rust name of the object (module of an array/record, type of
+    /// a var) or sub-entry.
+    pub rust_name: Option<Text>,
 }
 
 /// Named raw values, reserved ranges and the numeric range of a value.
@@ -161,6 +164,8 @@ pub struct NamedDef {
     pub range: Option<Spanned<Vec<Text>>>,
     pub name: Text,
     pub text: Option<Text>,
+    /// Pins the Rust name of the enum variant (UpperCamelCase).
+    pub rust_name: Option<Text>,
 }
 
 /// `bit: N` or `bits: [low, high]`, with a name.
@@ -174,6 +179,8 @@ pub struct BitDef {
     pub unit: Option<Text>,
     pub scale: Option<Spanned<f64>>,
     pub values: Option<Spanned<ValuesDef>>,
+    /// Pins the Rust name of the getter (snake_case).
+    pub rust_name: Option<Text>,
 }
 
 #[derive(Debug, Deserialize)]

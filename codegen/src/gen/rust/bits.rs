@@ -28,7 +28,13 @@ pub(crate) fn bit_struct(
     let ids: Vec<NameId> = s
         .bits
         .iter()
-        .map(|f| methods.request(&f.name, &format!("bit {}", f.lsb), Some(&f.origin)))
+        .map(|f| {
+            let key = format!("bit {}", f.lsb);
+            match &f.rust_name {
+                Some(pin) => methods.request_pinned(pin, &key, Some(&f.origin)),
+                None => methods.request(&f.name, &key, Some(&f.origin)),
+            }
+        })
         .collect();
     let pattern_ids: Vec<NameId> = s
         .patterns

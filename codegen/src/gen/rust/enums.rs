@@ -21,6 +21,8 @@ struct Variant<'a> {
     members: Vec<(i128, i128)>,
     /// Carries the raw value (ranges, merged names, the fallback).
     carries: bool,
+    /// The variant's name is a `rust_name:` pin.
+    pinned: bool,
 }
 
 /// A named single value of a table, as a constant of the raw newtype.
@@ -28,6 +30,8 @@ pub(crate) struct UnitValue {
     pub(crate) variant: Ident,
     pub(crate) source: String,
     pub(crate) raw: i128,
+    /// The variant's name was pinned: the constant follows it.
+    pub(crate) pinned: bool,
 }
 
 /// An enum over a value table: named values, optionally `Number(..)` for the
@@ -55,11 +59,17 @@ pub(crate) fn value_enum(
                 v.carries = true;
             }
             None => variants.push(Variant {
-                name: ns.request(
-                    &named.name,
-                    &format!("raw {}", named.low),
-                    Some(&named.origin),
-                ),
+                name: match &named.rust_name {
+                    Some(pin) => {
+                        ns.request_pinned(pin, &format!("raw {}", named.low), Some(&named.origin))
+                    }
+                    None => ns.request(
+                        &named.name,
+                        &format!("raw {}", named.low),
+                        Some(&named.origin),
+                    ),
+                },
+                pinned: named.rust_name.is_some(),
                 source: named.name.clone(),
                 text: named.text.as_deref(),
                 members: vec![(named.low, named.high)],
@@ -79,6 +89,7 @@ pub(crate) fn value_enum(
                 text: None,
                 members: Vec::new(),
                 carries: true,
+                pinned: false,
             });
             variants.len() - 1
         }
@@ -92,6 +103,7 @@ pub(crate) fn value_enum(
                 variant: names.get(v.name),
                 source: v.source.clone(),
                 raw: low,
+                pinned: v.pinned,
             })
         })
         .collect();
@@ -257,7 +269,14 @@ pub(crate) fn raw_newtype(
     let mut ns = Namespace::new(format!("impl `{name}` ({owner})"), Case::ShoutySnake);
     let ids: Vec<NameId> = units
         .iter()
-        .map(|u| ns.request(&u.source, &format!("raw {}", u.raw), None))
+        .map(|u| {
+            let key = format!("raw {}", u.raw);
+            if u.pinned {
+                ns.request_fixed(&u.variant.to_string(), &key, None)
+            } else {
+                ns.request(&u.source, &key, None)
+            }
+        })
         .collect();
     let names = ns.resolve(cx.diags);
     let consts = units.iter().zip(&ids).map(|(u, id)| {

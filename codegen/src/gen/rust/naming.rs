@@ -163,6 +163,8 @@ struct Request {
     origin: Option<Origin>,
     /// A canonical or pinned name: taken as it is.
     fixed: bool,
+    /// A `rust_name:` pin: meeting any other name of the scope is an error.
+    pinned: bool,
 }
 
 /// One scope of generated names (a module, an enum's variants, a struct's
@@ -245,6 +247,7 @@ impl Namespace {
             source: source.to_string(),
             origin: origin.cloned(),
             fixed: false,
+            pinned: false,
         });
         NameId(self.requests.len() - 1)
     }
@@ -269,8 +272,24 @@ impl Namespace {
             source: name.to_string(),
             origin: origin.cloned(),
             fixed: true,
+            pinned: false,
         });
         NameId(self.requests.len() - 1)
+    }
+
+    /// Requests a pinned name (`rust_name:`, already an identifier of this
+    /// scope's case): fixed like a canonical name, and any other name of the
+    /// scope that is the same (a source, canonical, generated or pinned name)
+    /// is a `gen::rust-name-collision` error naming both.
+    pub(crate) fn request_pinned(
+        &mut self,
+        pin: &str,
+        key: &str,
+        origin: Option<&Origin>,
+    ) -> NameId {
+        let id = self.request_fixed(pin, key, origin);
+        self.requests[id.0].pinned = true;
+        id
     }
 
     /// Resolves every request; collisions are reported into `diags`.
@@ -338,8 +357,53 @@ impl Namespace {
                 ));
             }
         }
+        // A pin that meets another name is an error, not a qualification.
+        let mut pin_reported = vec![false; self.requests.len()];
+        for (i, r) in self.requests.iter().enumerate().filter(|(_, r)| r.pinned) {
+            let mut others: Vec<String> = Vec::new();
+            if self.reserved.contains(&r.base) {
+                others.push(format!("`{}`, a name the generator uses there", r.base));
+            }
+            for (j, other) in self.requests.iter().enumerate() {
+                if j == i || other.base != r.base || (other.pinned && j < i) {
+                    continue;
+                }
+                let what = if other.pinned {
+                    "the pin `rust_name: "
+                } else if other.fixed {
+                    "the standard name `"
+                } else {
+                    "`"
+                };
+                others.push(format!(
+                    "{what}{}` ({})",
+                    other.source,
+                    at(other.origin.as_ref())
+                ));
+                pin_reported[j] = true;
+            }
+            if others.is_empty() {
+                continue;
+            }
+            pin_reported[i] = true;
+            let mut d = diagnostic(
+                r.origin.as_ref(),
+                format!(
+                    "`rust_name: {}` ({}) collides in {} with {}; a pinned name must be unique in its scope: pin another name",
+                    r.base,
+                    at(r.origin.as_ref()),
+                    self.scope,
+                    others.join(" and "),
+                ),
+                Vec::new(),
+            );
+            d.severity = Severity::Error;
+            d.code = "gen::rust-name-collision";
+            diags.push(d);
+        }
         // Qualified names may still meet each other or a reserved name:
-        // number them, in request order, and say so.
+        // number them, in request order, and say so (unless a pin's
+        // collision was already reported).
         let mut taken: Vec<String> = self.reserved.clone();
         for (i, name) in names.iter_mut().enumerate() {
             if taken.contains(name) {
@@ -350,14 +414,18 @@ impl Namespace {
                 }
                 let new = numbered(n);
                 let r = &self.requests[i];
-                diags.push(diagnostic(
-                    r.origin.as_ref(),
-                    format!(
-                        "`{}` would be `{name}` in {}, which is taken even after qualifying; it is named `{new}`",
-                        r.source, self.scope
-                    ),
-                    Vec::new(),
-                ));
+                // A pin's collision is an error already (the generated code
+                // is not used); the numbering only keeps the names apart.
+                if !pin_reported[i] {
+                    diags.push(diagnostic(
+                        r.origin.as_ref(),
+                        format!(
+                            "`{}` would be `{name}` in {}, which is taken even after qualifying; it is named `{new}`",
+                            r.source, self.scope
+                        ),
+                        Vec::new(),
+                    ));
+                }
                 if collided[i].is_none() {
                     collided[i] = Some(name.clone());
                 }
@@ -404,7 +472,7 @@ fn report(
     diags.push(diagnostic(
         first.origin.as_ref(),
         format!(
-            "`{}` ({}) and {} all become `{base}` in {scope}; each is qualified with its key (while the others exist: rename one in the source to make the names stable)",
+            "`{}` ({}) and {} all become `{base}` in {scope}; each is qualified with its key (while the others exist: rename one in the source, or pin its Rust name with `rust_name:` in a YAML table or overlay, to make the names stable)",
             first.source,
             at(first.origin.as_ref()),
             others.join(" and "),
@@ -485,6 +553,38 @@ mod tests {
             text.contains("a.eds:10") && text.contains("a.eds:20"),
             "{text}"
         );
+    }
+
+    #[test]
+    fn pins_are_kept_and_their_collisions_are_errors() {
+        let o = |line| Origin {
+            file: "a.yaml".into(),
+            line,
+        };
+        let mut ns = Namespace::new("module `od`", Case::UpperCamel);
+        ns.reserve("Unknown");
+        let pin = ns.request_pinned("Speed", "x2000", Some(&o(10)));
+        let source = ns.request("speed", "x2001", Some(&o(20)));
+        let free = ns.request_pinned("Gain", "x2002", Some(&o(30)));
+        let reserved = ns.request_pinned("Unknown", "x2003", Some(&o(40)));
+        let mut diags = Diagnostics::new();
+        let names = ns.resolve(&mut diags);
+        assert_eq!(names.text(pin), "Speed");
+        assert_eq!(names.text(free), "Gain");
+        assert_ne!(names.text(source), "Speed");
+        assert_ne!(names.text(reserved), "Unknown");
+        let errors: Vec<&Diagnostic> = diags
+            .iter()
+            .filter(|d| d.code == "gen::rust-name-collision" && d.severity == Severity::Error)
+            .collect();
+        assert_eq!(errors.len(), 2, "{}", diags.render());
+        assert!(
+            errors[0].message.contains("a.yaml:10") && errors[0].message.contains("a.yaml:20"),
+            "{}",
+            errors[0].message
+        );
+        // No second report of the same clash as a warning.
+        assert_eq!(diags.len(), 2, "{}", diags.render());
     }
 
     #[test]

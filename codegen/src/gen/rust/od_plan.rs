@@ -85,12 +85,18 @@ pub(crate) fn plan<'d>(
         let fixed = canonical.object(object.index);
         if is_var(object) {
             let entry = object.entries.values().next().expect("non-empty");
-            let (zst, name) = match &fixed {
-                Some(name) => (
+            // A pin (`rust_name:`) wins over the canonical and the source name.
+            let pin = entry.rust_name.as_deref().or(object.rust_name.as_deref());
+            let (zst, name) = match (pin, &fixed) {
+                (Some(pin), _) => (
+                    types.request_pinned(pin, &key, Some(&object.origin)),
+                    values::Name::Fixed(pin),
+                ),
+                (None, Some(name)) => (
                     types.request_fixed(name, &key, Some(&object.origin)),
                     values::Name::Fixed(name),
                 ),
-                None => (
+                (None, None) => (
                     types.request(&object.name, &key, Some(&object.origin)),
                     values::Name::Source(&entry.name),
                 ),
@@ -101,9 +107,10 @@ pub(crate) fn plan<'d>(
                 entry: EntryPlan { entry, zst, value },
             });
         } else {
-            let id = match &fixed {
-                Some(name) => modules.request_fixed(name, &key, Some(&object.origin)),
-                None => modules.request(&object.name, &key, Some(&object.origin)),
+            let id = match (&object.rust_name, &fixed) {
+                (Some(pin), _) => modules.request_pinned(pin, &key, Some(&object.origin)),
+                (None, Some(name)) => modules.request_fixed(name, &key, Some(&object.origin)),
+                (None, None) => modules.request(&object.name, &key, Some(&object.origin)),
             };
             module_ids.push((object, id, fixed.is_some()));
         }
@@ -124,12 +131,16 @@ pub(crate) fn plan<'d>(
                     let fixed = standard
                         .then(|| canonical.sub(object.index, entry.subindex))
                         .flatten();
-                    let (zst, name) = match &fixed {
-                        Some(name) => (
+                    let (zst, name) = match (&entry.rust_name, &fixed) {
+                        (Some(pin), _) => (
+                            ns.request_pinned(pin, &key, Some(&entry.origin)),
+                            values::Name::Fixed(pin),
+                        ),
+                        (None, Some(name)) => (
                             ns.request_fixed(name, &key, Some(&entry.origin)),
                             values::Name::Fixed(name),
                         ),
-                        None => (
+                        (None, None) => (
                             ns.request(&entry.name, &key, Some(&entry.origin)),
                             values::Name::Source(&entry.name),
                         ),

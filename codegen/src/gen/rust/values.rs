@@ -118,7 +118,11 @@ pub(crate) fn plan(
             let fields = s
                 .bits
                 .iter()
-                .map(|f| f.values.as_ref().map(|_| req(ns, &f.name)))
+                .map(|f| {
+                    f.values
+                        .as_ref()
+                        .map(|_| req(ns, f.rust_name.as_deref().unwrap_or(&f.name)))
+                })
                 .collect();
             let state = (!s.patterns.is_empty()).then(|| req(ns, "state"));
             return Plan::Bits {
