@@ -11,7 +11,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use eds2rust::diag::Levels;
+use eds2rust::diag::{Diagnostics, Levels};
 use eds2rust::input::{Options, read_device};
 
 #[derive(Parser)]
@@ -411,42 +411,35 @@ fn generate(
             let _ = write!(std::io::stderr().lock(), "{}", out.warnings.render());
             out.code
         }
-        Err(mut diagnostics) => {
-            diagnostics.errors_first();
-            let mut err = std::io::stderr().lock();
-            let _ = write!(err, "{}", diagnostics.render());
-            let _ = writeln!(
-                err,
-                "{}: not generated: {} errors",
-                path.display(),
-                diagnostics.error_count()
-            );
-            return ExitCode::from(1);
-        }
+        Err(diagnostics) => return failed(path, diagnostics, "generated"),
     };
     write_output(output, &code)
 }
 
 fn api(path: &std::path::Path, overlays: &[PathBuf], options: &Options) -> ExitCode {
-    match eds2rust::r#gen::rust::api_listing_files(path, overlays, options) {
+    match eds2rust::build::api_listing_files(path, overlays, options) {
         Ok(listing) => {
             let _ = write!(std::io::stderr().lock(), "{}", listing.warnings.render());
             let _ = std::io::stdout().lock().write_all(listing.text.as_bytes());
             ExitCode::SUCCESS
         }
-        Err(mut diagnostics) => {
-            diagnostics.errors_first();
-            let mut err = std::io::stderr().lock();
-            let _ = write!(err, "{}", diagnostics.render());
-            let _ = writeln!(
-                err,
-                "{}: not listed: {} errors",
-                path.display(),
-                diagnostics.error_count().max(1)
-            );
-            ExitCode::from(1)
-        }
+        Err(diagnostics) => failed(path, diagnostics, "listed"),
     }
+}
+
+/// Prints the diagnostics of a failed input, errors first, then
+/// `FILE: not <what>: N errors`; exit status 1.
+fn failed(path: &std::path::Path, mut diagnostics: Diagnostics, what: &str) -> ExitCode {
+    diagnostics.errors_first();
+    let mut err = std::io::stderr().lock();
+    let _ = write!(err, "{}", diagnostics.render());
+    let _ = writeln!(
+        err,
+        "{}: not {what}: {} errors",
+        path.display(),
+        diagnostics.error_count().max(1)
+    );
+    ExitCode::from(1)
 }
 
 /// Writes `text` to standard output, or whole to `output`.

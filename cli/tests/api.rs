@@ -10,7 +10,7 @@ fn api_lists_the_generated_api_or_errors() {
     let (code, stdout, stderr) = run(&["api", &linak]);
     assert_eq!(code, 0, "{stderr}");
     let options = eds2rust::read::Options::default();
-    let library = eds2rust::r#gen::rust::api_listing_files(linak.as_ref(), &[], &options);
+    let library = eds2rust::build::api_listing_files(linak.as_ref(), &[], &options);
     assert_eq!(
         stdout,
         library.expect("lists").text,

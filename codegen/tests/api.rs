@@ -6,7 +6,8 @@ use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use eds2rust::r#gen::rust::{Options, api_listing, api_listing_files, generate};
+use eds2rust::build::api_listing_files;
+use eds2rust::r#gen::rust::{Options, api_listing, generate};
 use eds2rust::ir::Device;
 
 fn repo(path: &str) -> PathBuf {

@@ -8,7 +8,7 @@ const TABLE: &str = "../../eds/linak_techline.yaml";
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     eds2rust::Builder::new().device("linak", TABLE).generate()?;
-    let listing = eds2rust::r#gen::rust::api_listing_files(
+    let listing = eds2rust::build::api_listing_files(
         Path::new(TABLE),
         &[],
         &eds2rust::read::Options::default(),

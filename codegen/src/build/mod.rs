@@ -149,6 +149,46 @@ pub fn load_device(input: &Path, overlays: &[PathBuf], options: &crate::read::Op
     }
 }
 
+/// Reads `input`, applies the YAML `overlays` in order and lists the API of
+/// the device, as [`generate_device_with`] reads and generates it: the
+/// files' `diagnostics:` levels, `read.levels` over them and `read.strict`
+/// apply to every diagnostic. The `Err` holds every diagnostic when there is
+/// an error.
+pub fn api_listing_files(
+    input: &Path,
+    overlays: &[PathBuf],
+    read: &crate::read::Options,
+) -> Result<rust::ApiListing, Diagnostics> {
+    let loaded = load_device(input, overlays, read);
+    let mut diagnostics = loaded.diagnostics;
+    let device = match loaded.device {
+        Some(device) if !diagnostics.has_errors() => device,
+        _ => return Err(diagnostics),
+    };
+    match rust::api_listing(&device, &Options::default()) {
+        Ok(listing) => {
+            let mut warnings = listing.warnings;
+            warnings.apply_levels(&loaded.levels.merged(&read.levels), read.strict);
+            diagnostics.extend(warnings);
+            diagnostics.sort();
+            if diagnostics.has_errors() {
+                Err(diagnostics)
+            } else {
+                Ok(rust::ApiListing {
+                    text: listing.text,
+                    warnings: diagnostics,
+                })
+            }
+        }
+        Err(mut errors) => {
+            errors.apply_levels(&loaded.levels.merged(&read.levels), read.strict);
+            diagnostics.extend(errors);
+            diagnostics.sort();
+            Err(diagnostics)
+        }
+    }
+}
+
 /// What [`load`] gives: the device after every overlay, every diagnostic
 /// (no levels applied yet), the files read, and the levels the files set.
 struct LoadedDevice {

@@ -138,29 +138,12 @@ fn object(cx: &mut Cx, old: &Object, new: &Object) {
     // with its former self but the index: only subs added and removed.
     let reshaped = is_var(old) != is_var(new);
     if object_renamed {
-        let severity = if moved {
-            Severity::Breaking
-        } else {
-            Severity::Compatible
-        };
-        let how = if moved {
-            format!(
-                " (`{}` → `{}`)",
-                shown_path(&old_path),
-                shown_path(&new_path)
-            )
-        } else {
-            String::new()
-        };
-        cx.push(
+        push_rename(
+            cx,
             index,
             None,
-            Kind::NameChanged,
-            severity,
-            new_path.clone(),
-            Some(Val::Text(old.name.clone())),
-            Some(Val::Text(new.name.clone())),
-            format!("name `{}` → `{}`{how}", old.name, new.name),
+            (&old.name, &new.name),
+            (&old_path, &new_path),
         );
     }
     let mut subs: Vec<u8> = old
@@ -206,6 +189,36 @@ fn object(cx: &mut Cx, old: &Object, new: &Object) {
     }
 }
 
+/// A source name changed: breaking when its Rust path moved with it,
+/// compatible when the path stayed.
+fn push_rename(
+    cx: &mut Cx,
+    index: u16,
+    sub: Option<u8>,
+    (old_name, new_name): (&str, &str),
+    (old_path, new_path): (&Option<String>, &Option<String>),
+) {
+    let moved = old_path != new_path;
+    let (severity, how) = if moved {
+        (
+            Severity::Breaking,
+            format!(" (`{}` → `{}`)", shown_path(old_path), shown_path(new_path)),
+        )
+    } else {
+        (Severity::Compatible, String::new())
+    };
+    cx.push(
+        index,
+        sub,
+        Kind::NameChanged,
+        severity,
+        new_path.clone(),
+        Some(Val::Text(old_name.to_string())),
+        Some(Val::Text(new_name.to_string())),
+        format!("name `{old_name}` → `{new_name}`{how}"),
+    );
+}
+
 fn shown_path(path: &Option<String>) -> &str {
     path.as_deref().unwrap_or("not generated")
 }
@@ -222,29 +235,12 @@ fn entry(cx: &mut Cx, old_object: &Object, old: &Entry, new: &Entry, object_rena
     // object); its entry's own name is compared here too.
     let renamed = old.name != new.name && !(is_var(old_object) && object_renamed);
     if renamed {
-        let severity = if moved {
-            Severity::Breaking
-        } else {
-            Severity::Compatible
-        };
-        let how = if moved {
-            format!(
-                " (`{}` → `{}`)",
-                shown_path(&old_path),
-                shown_path(&new_path)
-            )
-        } else {
-            String::new()
-        };
-        cx.push(
+        push_rename(
+            cx,
             index,
             Some(sub),
-            Kind::NameChanged,
-            severity,
-            path.clone(),
-            Some(Val::Text(old.name.clone())),
-            Some(Val::Text(new.name.clone())),
-            format!("name `{}` → `{}`{how}", old.name, new.name),
+            (&old.name, &new.name),
+            (&old_path, &new_path),
         );
     } else if moved && !object_renamed {
         cx.push(

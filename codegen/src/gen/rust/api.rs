@@ -6,7 +6,6 @@
 //! error plan, the PDO plan), so the listing cannot drift from the code.
 
 use std::fmt::Write as _;
-use std::path::{Path, PathBuf};
 
 use quote::quote;
 
@@ -33,46 +32,6 @@ pub fn api_listing(device: &Device, options: &Options) -> Result<ApiListing, Dia
         text: listing(device),
         warnings: output.warnings,
     })
-}
-
-/// Reads `input`, applies the YAML `overlays` in order and lists the API of
-/// the device, as `build::generate_device_with` reads and generates it: the
-/// files' `diagnostics:` levels, `read.levels` over them and `read.strict`
-/// apply to every diagnostic. The `Err` holds every diagnostic when there is
-/// an error.
-pub fn api_listing_files(
-    input: &Path,
-    overlays: &[PathBuf],
-    read: &crate::read::Options,
-) -> Result<ApiListing, Diagnostics> {
-    let loaded = crate::build::load_device(input, overlays, read);
-    let mut diagnostics = loaded.diagnostics;
-    let device = match loaded.device {
-        Some(device) if !diagnostics.has_errors() => device,
-        _ => return Err(diagnostics),
-    };
-    match api_listing(&device, &Options::default()) {
-        Ok(listing) => {
-            let mut warnings = listing.warnings;
-            warnings.apply_levels(&loaded.levels.merged(&read.levels), read.strict);
-            diagnostics.extend(warnings);
-            diagnostics.sort();
-            if diagnostics.has_errors() {
-                Err(diagnostics)
-            } else {
-                Ok(ApiListing {
-                    text: listing.text,
-                    warnings: diagnostics,
-                })
-            }
-        }
-        Err(mut errors) => {
-            errors.apply_levels(&loaded.levels.merged(&read.levels), read.strict);
-            diagnostics.extend(errors);
-            diagnostics.sort();
-            Err(diagnostics)
-        }
-    }
 }
 
 /// Where a line sorts: `od` by (index, subindex; -1 for a module), `pdo` by

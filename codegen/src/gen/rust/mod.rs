@@ -31,7 +31,7 @@ mod prim;
 mod scaled;
 mod values;
 
-pub use api::{ApiListing, api_listing, api_listing_files};
+pub use api::{ApiListing, api_listing};
 
 use proc_macro2::TokenStream;
 use quote::quote;
