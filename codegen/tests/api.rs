@@ -129,8 +129,10 @@ fn check_paths(path: &Path) -> usize {
     for line in text.lines() {
         let columns: Vec<&str> = line.split('\t').collect();
         assert!(columns.len() >= 3, "{}: {line:?}", path.display());
+        // An indexed type is listed with its parameter: `Type<SUB>`.
+        let item = columns[0].strip_suffix("<SUB>").unwrap_or(columns[0]);
         assert!(
-            items.contains(columns[0]),
+            items.contains(item),
             "{}: `{}` is not an item of the generated code",
             path.display(),
             columns[0]
@@ -221,7 +223,11 @@ fn lines_are_sorted_by_key_and_od_comes_first() {
             let key = l.split('\t').nth(1).expect("a key");
             let hex = key.trim_start_matches("0x");
             let (index, sub) = match hex.split_once('.') {
-                Some((i, s)) => (i, s.parse::<i32>().expect("decimal sub")),
+                // `1..254` for an indexed type: sorted by its first sub.
+                Some((i, s)) => {
+                    let first = s.split_once("..").map_or(s, |(first, _)| first);
+                    (i, first.parse::<i32>().expect("decimal sub"))
+                }
                 None => (hex, -1),
             };
             (u16::from_str_radix(index, 16).expect("hex index"), sub)

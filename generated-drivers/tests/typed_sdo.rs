@@ -171,3 +171,65 @@ fn object_table_fills_an_sdo_store() {
     stop.store(true, Ordering::Relaxed);
     handle.join().unwrap();
 }
+
+/// The elements of an ARRAY over SDO, in both forms: an element fixed at
+/// compile time (`PreDefinedErrorField<1>`) and elements chosen at run time
+/// (`Element::<PreDefinedErrorField>`), against an Interroll-like server
+/// holding an error history of 8 codes (0x1003, chapter 5.1) and LINAK's
+/// consumer heartbeat time (0x1016 sub 1, rw).
+#[test]
+fn array_elements_read_and_write_in_both_forms() {
+    use eds2rust_drivers::interroll_ec5000bi::od::pre_defined_error_field::PreDefinedErrorField;
+    use eds2rust_drivers::linak_techline::od::consumer_heartbeat_time::{
+        ConsumerHeartbeatTime, ConsumerHeartbeatTimeValue,
+    };
+    use eds2rust_runtime::od::{Array, Element};
+
+    let bus = VirtualBus::new();
+    let stop = Arc::new(AtomicBool::new(false));
+    let mut store = MemoryStore::new();
+    for sub in PreDefinedErrorField::FIRST..=PreDefinedErrorField::LAST {
+        // Code 0x3210 + sub in the low 16 bits of each error field.
+        let code = 0x3210u32 + u32::from(sub);
+        store.insert_fixed(0x1003, sub, AccessRight::Ro, &code.to_le_bytes());
+    }
+    store.insert_fixed(0x1016, 1, AccessRight::Rw, &[0, 0, 0, 0]);
+    let node = NodeId::new(5).unwrap();
+    let mut server = SdoServer::new(ServerConfig::new(Channel::default_for(node)), store);
+    let mut port = bus.attach();
+    let server_stop = stop.clone();
+    let server = thread::spawn(move || {
+        blocking::serve(
+            &mut port,
+            &Clock::new(),
+            &mut server,
+            &server_stop,
+            None,
+            |_| {},
+        )
+        .unwrap();
+        server.into_store()
+    });
+    let mut client = SdoClient::new(bus.attach(), ClientConfig::new(Channel::default_for(node)));
+
+    // Compile-time form.
+    let newest = client.read::<PreDefinedErrorField<1>>().unwrap();
+    assert_eq!(newest.to_raw(), 0x3211);
+    // Run-time form: every element in order.
+    let codes: Vec<u32> = Element::<PreDefinedErrorField>::all()
+        .map(|at| client.read_at(at).unwrap().to_raw())
+        .collect();
+    assert_eq!(codes, (0x3211..=0x3218).collect::<Vec<u32>>());
+    // A sub-index from outside (a user's input) is checked first.
+    assert!(Element::<PreDefinedErrorField>::new(9).is_none());
+
+    // Writing an rw element at run time; reading it back at compile time.
+    let watch = ConsumerHeartbeatTimeValue::from_raw(0x0001_00C8);
+    let first = Element::<ConsumerHeartbeatTime>::new(1).unwrap();
+    client.write_at(first, watch).unwrap();
+    assert_eq!(client.read::<ConsumerHeartbeatTime<1>>().unwrap(), watch);
+
+    stop.store(true, Ordering::Relaxed);
+    let store = server.join().unwrap();
+    assert_eq!(store.get(0x1016, 1), Some(&[0xC8, 0x00, 0x01, 0x00][..]));
+}

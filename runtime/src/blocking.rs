@@ -442,8 +442,7 @@ impl<B: Bus> SdoClient<B> {
         E::Access: od::Read,
         E::Value: od::Scalar,
     {
-        let data = self.upload(E::INDEX, E::SUBINDEX)?;
-        Ok(od::decode_value::<E>(&data)?)
+        self.read_sub::<E>(E::SUBINDEX)
     }
 
     /// Writes `value` to entry `E`.
@@ -453,8 +452,7 @@ impl<B: Bus> SdoClient<B> {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value)?;
-        self.download(E::INDEX, E::SUBINDEX, buf.get(..len).unwrap_or(&buf))
+        self.write_sub::<E>(E::SUBINDEX, value)
     }
 
     /// Reads the bytes of a string, DOMAIN or other byte-valued entry.
@@ -486,6 +484,71 @@ impl<B: Bus> SdoClient<B> {
         E::Value: od::ByteValue,
     {
         self.download(E::INDEX, E::SUBINDEX, data)
+    }
+
+    /// Reads element `at` of an ARRAY: the run-time form of
+    /// [`Self::read`] with `A<SUB>`.
+    pub fn read_at<A>(&mut self, at: od::Element<A>) -> Result<A::Value, Error>
+    where
+        A: od::Array,
+        A::Access: od::Read,
+        A::Value: od::Scalar,
+    {
+        self.read_sub::<A>(at.subindex())
+    }
+
+    /// Writes `value` to element `at` of an ARRAY.
+    pub fn write_at<A>(&mut self, at: od::Element<A>, value: A::Value) -> Result<(), Error>
+    where
+        A: od::Array,
+        A::Access: od::Write,
+        A::Value: od::Scalar,
+    {
+        self.write_sub::<A>(at.subindex(), value)
+    }
+
+    /// Reads the bytes of element `at` of a byte-valued ARRAY (DOMAIN,
+    /// strings).
+    pub fn read_bytes_at<A>(&mut self, at: od::Element<A>) -> Result<Vec<u8>, Error>
+    where
+        A: od::Array,
+        A::Access: od::Read,
+        A::Value: od::ByteValue,
+    {
+        self.upload(A::INDEX, at.subindex())
+    }
+
+    /// Writes the bytes of element `at` of a byte-valued ARRAY.
+    pub fn write_bytes_at<A>(&mut self, at: od::Element<A>, data: &[u8]) -> Result<(), Error>
+    where
+        A: od::Array,
+        A::Access: od::Write,
+        A::Value: od::ByteValue,
+    {
+        self.download(A::INDEX, at.subindex(), data)
+    }
+
+    /// Typed read of sub `sub` of `E`'s object (an entry's own, or an
+    /// array element's).
+    fn read_sub<E>(&mut self, sub: u8) -> Result<E::Value, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::Scalar,
+    {
+        let data = self.upload(E::INDEX, sub)?;
+        Ok(od::decode_value::<E>(&data)?)
+    }
+
+    /// Typed write of sub `sub` of `E`'s object.
+    fn write_sub<E>(&mut self, sub: u8, value: E::Value) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::Scalar,
+    {
+        let (buf, len) = encode::<E>(value)?;
+        self.download(E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
     }
 }
 

@@ -13,6 +13,12 @@
 
 use core::fmt;
 
+mod array;
+mod info;
+
+pub use array::{Array, Element, Elements, array_subindex};
+pub use info::{DefaultValue, Number, ObjectInfo};
+
 /// A CiA 301 basic data type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum DataType {
@@ -225,7 +231,8 @@ impl<E> TpdoAccess<E> for access::Rww {}
 impl<E> TpdoAccess<E> for access::Const {}
 
 /// One object-dictionary entry (a VAR, or one sub-entry of an ARRAY or
-/// RECORD), implemented by a generated zero-sized type.
+/// RECORD), implemented by a generated zero-sized type. The elements of an
+/// ARRAY are one generated type indexed by sub-index ([`Array`]).
 pub trait Entry {
     const INDEX: u16;
     const SUBINDEX: u8;
@@ -536,11 +543,16 @@ pub const fn mapping_entry<E: PdoMappable>() -> u32 {
 
 /// `index << 16 | subindex << 8 | bits` of `E` (bits 0 without a fixed size).
 const fn mapping_value<E: Entry>() -> u32 {
-    let bits = match E::DATA_TYPE.size() {
+    mapping_bits(E::INDEX, E::SUBINDEX, E::DATA_TYPE)
+}
+
+/// `index << 16 | subindex << 8 | bits` (bits 0 without a fixed size).
+const fn mapping_bits(index: u16, subindex: u8, data_type: DataType) -> u32 {
+    let bits = match data_type.size() {
         Some(bytes) => bytes as u32 * 8,
         None => 0,
     };
-    (E::INDEX as u32) << 16 | (E::SUBINDEX as u32) << 8 | bits
+    (index as u32) << 16 | (subindex as u32) << 8 | bits
 }
 
 /// A CANopen node id, 1 to 127.
@@ -618,80 +630,4 @@ pub trait Pdo: Sized {
     fn decode(data: &[u8]) -> Result<Self, PdoLengthError>;
     /// Encodes into the first [`Pdo::LEN`] bytes of `out`; returns that length.
     fn encode_into(&self, out: &mut [u8; 8]) -> usize;
-}
-
-/// A number from an object description (default or limit).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Number {
-    /// Integers, BOOLEAN and the TIME types (as their raw integer).
-    Int(i128),
-    /// REAL32 and REAL64.
-    Real(f64),
-}
-
-/// The default value of an entry, as the source gives it.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum DefaultValue {
-    Number(Number),
-    /// `$NODEID + value`: the node id is added for a given node.
-    NodeRelative(i128),
-    /// Strings and domains: their bytes.
-    Bytes(&'static [u8]),
-}
-
-/// The description of one entry as plain data, for code that works on the
-/// whole dictionary at run time (device simulators, configuration tools).
-/// Generated code lists every entry in `od::OBJECTS`, sorted by index and
-/// subindex.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ObjectInfo {
-    pub index: u16,
-    pub subindex: u8,
-    /// The entry's name in the source.
-    pub name: &'static str,
-    pub data_type: DataType,
-    pub access: AccessRight,
-    pub pdo_mappable: bool,
-    pub default: Option<DefaultValue>,
-    pub low_limit: Option<Number>,
-    pub high_limit: Option<Number>,
-}
-
-impl ObjectInfo {
-    /// The little-endian bus form of a numeric default for `node` (needed
-    /// for `$NODEID` defaults) into `out`; returns its length. `None` for
-    /// byte defaults, entries without a fixed size, a node-relative default
-    /// without a node, or a value that does not fit the type.
-    pub fn encode_default(&self, node: Option<NodeId>, out: &mut [u8; 8]) -> Option<usize> {
-        let size = self.data_type.size()?;
-        let raw: u64 = match self.default? {
-            DefaultValue::Number(Number::Int(v)) => int_bits(v, self.data_type, size)?,
-            DefaultValue::NodeRelative(v) => {
-                int_bits(v + i128::from(node?.get()), self.data_type, size)?
-            }
-            DefaultValue::Number(Number::Real(f)) => match self.data_type {
-                DataType::Real32 => u64::from((f as f32).to_bits()),
-                DataType::Real64 => f.to_bits(),
-                _ => return None,
-            },
-            DefaultValue::Bytes(_) => return None,
-        };
-        let bytes = raw.to_le_bytes();
-        out[..size].copy_from_slice(&bytes[..size]);
-        Some(size)
-    }
-}
-
-/// The two's-complement bits of `v` in `size` bytes, when it fits the type.
-fn int_bits(v: i128, data_type: DataType, size: usize) -> Option<u64> {
-    let bits = 8 * size as u32;
-    let (min, max) = if data_type.is_signed() {
-        (-(1i128 << (bits - 1)), (1i128 << (bits - 1)) - 1)
-    } else {
-        (0, (1i128 << bits) - 1)
-    };
-    if v < min || v > max {
-        return None;
-    }
-    Some(v as u64 & (u64::MAX >> (64 - bits)))
 }

@@ -142,7 +142,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<Summary> {
     let consume = ConsumerHeartbeatTimeValue::from_raw(0)
         .with_node_id(MASTER_NODE)
         .with_heartbeat_time(CONSUMER_TIME_MS);
-    m.write::<ConsumerHeartbeatTime>(NODE, consume)?;
+    m.write::<ConsumerHeartbeatTime<1>>(NODE, consume)?;
     writeln!(
         out,
         "node {NODE}: consumes the heartbeat of node {MASTER_NODE}, {CONSUMER_TIME_MS} ms (0x1016 sub 1)"

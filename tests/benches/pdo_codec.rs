@@ -297,7 +297,7 @@ mod values {
     pub fn hand_zm_tpdo3(t: &hand::ZmFollowingTorque) -> [i64; 2] { [t.following_error.into(), t.torque.into()] }
     pub fn ir_rpdo1(r: &ir::pdo::Rpdo1VelocityCommand) -> [i64; 18] {
         let c = r.controlword;
-        let head = [c.to_raw().into(), r.mode_of_operation.to_raw().into(), r.profile_velocity.to_raw().into()];
+        let head = [c.to_raw().into(), r.modes_of_operation.to_raw().into(), r.profile_velocity.to_raw().into()];
         join(&head, &ir_control(c))
     }
     pub fn hand_ir_rpdo1(r: &hand::IrVelocityCommand) -> [i64; 18] {
@@ -315,7 +315,7 @@ mod values {
     }
     pub fn ir_tpdo1(t: &ir::pdo::Tpdo1Status) -> [i64; 28] {
         let (s, e) = (t.statusword, t.error_register);
-        let head = [s.to_raw().into(), t.mode_of_operation_display.to_raw().into(), e.to_raw().into(),
+        let head = [s.to_raw().into(), t.modes_of_operation_display.to_raw().into(), e.to_raw().into(),
                     t.actual_temperature.to_raw().into(), t.torque_actual_value.to_raw().into()];
         let mut v: [i64; 28] = join(&head, &ir_status(s));
         v[21..].copy_from_slice(&ir_error_register(e).map(i64::from));

@@ -21,6 +21,18 @@ fn without_path_shifts(changes: &[Change]) -> Vec<&Change> {
         .collect()
 }
 
+/// A copy of `device` with (index, sub) made read-only.
+fn read_only(device: &Device, index: u16, sub: u8) -> Device {
+    let mut mutated = device.clone();
+    let entry = mutated
+        .objects
+        .get_mut(&index)
+        .and_then(|o| o.entries.get_mut(&sub))
+        .expect("the entry exists");
+    entry.access = Access::Ro;
+    mutated
+}
+
 fn one(changes: &[Change], what: &str) -> Change {
     assert_eq!(changes.len(), 1, "{what}: {changes:#?}");
     changes[0].clone()
@@ -31,7 +43,7 @@ fn corpus_files_against_themselves_and_mutations() {
     let Some(files) = eds2rust_tests::corpus_files("diff corpus test") else {
         return;
     };
-    let mut counts = [0usize; 5];
+    let mut counts = [0usize; 6];
     for path in &files {
         let name = path.display().to_string();
         let device = read_file(path, &Options::default())
@@ -77,21 +89,16 @@ fn corpus_files_against_themselves_and_mutations() {
         }
 
         // An access right narrowed (rw → ro): breaking, nothing else.
+        // (Not in an ARRAY: narrowing one element splits its indexed type,
+        // checked below.)
         let rw = device
             .objects
             .values()
+            .filter(|o| o.kind != ObjectKind::Array && !is_mapping_object(o.index))
             .flat_map(|o| o.entries.values().map(move |e| (o.index, e)))
             .find(|(_, e)| e.access == Access::Rw);
         if let Some((index, entry)) = rw {
-            let mut mutated = device.clone();
-            mutated
-                .objects
-                .get_mut(&index)
-                .unwrap()
-                .entries
-                .get_mut(&entry.subindex)
-                .unwrap()
-                .access = Access::Ro;
+            let mutated = read_only(&device, index, entry.subindex);
             let c = one(&diff::diff(&device, &mutated), &name);
             assert_eq!(
                 (c.index, c.subindex, c.kind, c.severity),
@@ -111,6 +118,33 @@ fn corpus_files_against_themselves_and_mutations() {
                 "{name}"
             );
             counts[1] += 1;
+        }
+
+        // One element of an array narrowed (rw → ro): its array is no
+        // longer one indexed type, so the paths of its elements change
+        // (breaking), and nothing outside that object does.
+        let element = device
+            .objects
+            .values()
+            .filter(|o| o.kind == ObjectKind::Array && o.entries.len() > 2)
+            .flat_map(|o| o.entries.values().map(move |e| (o.index, e)))
+            .find(|(_, e)| e.subindex > 0 && e.access == Access::Rw);
+        if let Some((index, entry)) = element {
+            let mutated = read_only(&device, index, entry.subindex);
+            let changes = diff::diff(&device, &mutated);
+            assert!(
+                changes
+                    .iter()
+                    .any(|c| c.kind == Kind::AccessChanged && c.subindex == Some(entry.subindex)),
+                "{name}: {changes:#?}"
+            );
+            assert!(
+                changes
+                    .iter()
+                    .all(|c| c.index == index && c.severity == Severity::Breaking),
+                "{name}: {changes:#?}"
+            );
+            counts[5] += 1;
         }
 
         // A plain integer default changed: compatible.
@@ -203,13 +237,14 @@ fn corpus_files_against_themselves_and_mutations() {
         }
     }
     println!(
-        "{} files: {} removals, {} narrowed, {} defaults, {} renames, {} text mutations",
+        "{} files: {} removals, {} narrowed, {} defaults, {} renames, {} text mutations, {} array elements narrowed",
         files.len(),
         counts[0],
         counts[1],
         counts[2],
         counts[3],
-        counts[4]
+        counts[4],
+        counts[5]
     );
     assert!(
         counts.iter().all(|&n| n > 0),
@@ -217,8 +252,8 @@ fn corpus_files_against_themselves_and_mutations() {
     );
 }
 
-/// The EDS text with the first `AccessType=rw` of a section outside
-/// 0x1400–0x1BFF turned into `wo`.
+/// The EDS text with the first `AccessType=rw` of an object section
+/// outside 0x1400–0x1BFF turned into `wo`.
 fn narrow_in_text(text: &str) -> Option<String> {
     let mut section_ok = false;
     let mut out = String::with_capacity(text.len());
@@ -226,8 +261,10 @@ fn narrow_in_text(text: &str) -> Option<String> {
     for line in text.split_inclusive('\n') {
         let trimmed = line.trim();
         if let Some(name) = trimmed.strip_prefix('[').and_then(|s| s.strip_suffix(']')) {
+            // A VAR object's own section (not a sub-entry: an ARRAY element
+            // narrowed alone splits the array's indexed type).
             section_ok =
-                u16::from_str_radix(name.get(..4).unwrap_or(""), 16).is_ok_and(|i| !pdo_object(i));
+                name.len() == 4 && u16::from_str_radix(name, 16).is_ok_and(|i| !pdo_object(i));
         }
         if !done && section_ok && trimmed.eq_ignore_ascii_case("AccessType=rw") {
             out.push_str(&line.replacen("rw", "wo", 1));

@@ -49,8 +49,9 @@ const PINNED: &str = "codegen/tests/fixtures/rust_name.yaml";
 /// Corpus files (../shared/eds-corpus/files) whose generated code is
 /// snapshotted, chosen for variety.
 const CORPUS_SNAPSHOTS: &[&str] = &[
-    // A CiA 402 drive: ESAcademy stepper; DOMAIN entries, 8 default PDOs and
-    // 8 name collisions (the base of tests/overlays/cia402_stepper.yaml).
+    // A CiA 402 drive: ESAcademy stepper; DOMAIN entries, 8 default PDOs
+    // (the base of tests/overlays/cia402_stepper.yaml). Its 8 name
+    // collisions ("Standard error field") went with arrays as one type.
     "esacademy_cia402-stepper-node8.eds",
     // A CiA 401 generic I/O node: ARRAYs of digital/analogue channels, 8 PDOs.
     "esacademy_cia401-io-node3.eds",
@@ -65,8 +66,11 @@ const CORPUS_SNAPSHOTS: &[&str] = &[
     "faulhaber_cc_605.3150.51-V.eds",
     // The smallest file: 137 bytes, one ARRAY object, no identity.
     "node-canopen_sample-tiny.eds",
-    // gen::name-collision warnings (CANopenNode's repeated sub names).
+    // CANopenNode's repeated sub names (their collisions went with arrays
+    // as one indexed type).
     "canopennode_ds301-profile.eds",
+    // gen::name-collision warnings: two objects named alike.
+    "marathon_test-product.eds",
     // A vendor motor controller with 8 default PDOs and many vendor objects.
     "roboteq_motor-controller_v60.eds",
     // Every data type, including the odd-sized integers; UTF-8 non-ASCII text.
@@ -371,6 +375,7 @@ fn generated_code_compiles_under_clippy() {
     let (mut modules, mut failures, mut read_failed) = (Vec::new(), Vec::new(), Vec::new());
     let mut names = BTreeSet::new();
     let mut lines = 0;
+    let mut largest = (0, String::new());
     for (i, (display, path)) in inputs.iter().enumerate() {
         match generate_input(display, path) {
             Generated::Ok(output) => {
@@ -379,7 +384,11 @@ fn generated_code_compiles_under_clippy() {
                     names.insert(module.clone()),
                     "two inputs give module `{module}`"
                 );
-                lines += output.code.lines().count();
+                let count = output.code.lines().count();
+                lines += count;
+                if count > largest.0 {
+                    largest = (count, display.clone());
+                }
                 modules.push((module, output.code));
             }
             Generated::Failed(d) => failures.push(format!("{display}:\n{}", d.render())),
@@ -406,9 +415,22 @@ fn generated_code_compiles_under_clippy() {
     }
 
     println!(
-        "{} files generated ({} not generated: reader errors), {lines} generated lines, in {generated:.1?}",
+        "{} files generated ({} not generated: reader errors), {lines} generated lines \
+         (largest: {} with {}), in {generated:.1?}",
         modules.len(),
         read_failed.len(),
+        largest.1,
+        largest.0,
+    );
+    // A generated file is read in review: arrays are one indexed type and
+    // OBJECTS one line per entry, so no input comes near this (the largest
+    // corpus file gives about 19,100 lines; it gave 66,000 with a type per
+    // array element).
+    assert!(
+        largest.0 < 20_000,
+        "{} generates {} lines; a generated file should stay under 20,000",
+        largest.1,
+        largest.0
     );
     let (dir, written) = write_scratch_crate(&modules);
     let checking = Instant::now();

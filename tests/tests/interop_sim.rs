@@ -282,7 +282,7 @@ fn interroll_tpdos_read_and_decode_alike() {
     let p = Tpdo1Status::decode(data).expect("TPDO1 length");
     let ours = [
         i128::from(p.statusword.0),
-        i128::from(p.mode_of_operation_display.0),
+        i128::from(p.modes_of_operation_display.0),
         i128::from(p.error_register.0),
         i128::from(p.actual_temperature.0),
         i128::from(p.torque_actual_value.0),

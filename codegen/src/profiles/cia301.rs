@@ -107,6 +107,8 @@ pub(super) const OBJECTS: &[StdName] = &[
     obj(0x1027, "ModuleList", "Module list"),
     obj(0x1028, "EmergencyConsumer", "Emergency consumer object"),
     obj(0x1029, "ErrorBehavior", "Error behavior object"),
+    // Sub 1 is the standard's; subs 2 and up are profile or vendor errors.
+    sub(0x1029, 1, "CommunicationError", "Communication error"),
     // The default SDO server; the further ones are numbered below.
     obj(0x1200, "SdoServerParameter", "SDO server parameter"),
     sub(
@@ -160,6 +162,7 @@ pub(super) const RANGES: &[NumberedRange] = &[
         name: ("SdoServer", "Parameter"),
         text: "SDO server parameter",
         subs: SDO_SERVER_SUBS,
+        list: false,
     },
     NumberedRange {
         first: 0x1280,
@@ -168,6 +171,7 @@ pub(super) const RANGES: &[NumberedRange] = &[
         name: ("SdoClient", "Parameter"),
         text: "SDO client parameter",
         subs: SDO_CLIENT_SUBS,
+        list: false,
     },
     NumberedRange {
         first: 0x1400,
@@ -176,6 +180,7 @@ pub(super) const RANGES: &[NumberedRange] = &[
         name: ("Rpdo", "CommunicationParameter"),
         text: "RPDO communication parameter",
         subs: RPDO_COMM_SUBS,
+        list: false,
     },
     NumberedRange {
         first: 0x1600,
@@ -184,6 +189,8 @@ pub(super) const RANGES: &[NumberedRange] = &[
         name: ("Rpdo", "MappingParameter"),
         text: "RPDO mapping parameter",
         subs: &[],
+        // Subs 1 to 64 are the mapped application objects: one list.
+        list: true,
     },
     NumberedRange {
         first: 0x1800,
@@ -192,6 +199,7 @@ pub(super) const RANGES: &[NumberedRange] = &[
         name: ("Tpdo", "CommunicationParameter"),
         text: "TPDO communication parameter",
         subs: TPDO_COMM_SUBS,
+        list: false,
     },
     NumberedRange {
         first: 0x1A00,
@@ -200,5 +208,7 @@ pub(super) const RANGES: &[NumberedRange] = &[
         name: ("Tpdo", "MappingParameter"),
         text: "TPDO mapping parameter",
         subs: &[],
+        // Subs 1 to 64 are the mapped application objects: one list.
+        list: true,
     },
 ];

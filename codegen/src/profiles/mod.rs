@@ -59,6 +59,10 @@ pub(crate) struct NumberedRange {
     pub(crate) name: (&'static str, &'static str),
     pub(crate) text: &'static str,
     pub(crate) subs: &'static [(u8, &'static str, &'static str)],
+    /// Whether subs 1 and up are one list of like entries (the mapped
+    /// objects of a PDO mapping parameter): generated as one indexed type,
+    /// like an ARRAY's elements, whatever object code the source gives.
+    pub(crate) list: bool,
 }
 
 impl NumberedRange {
@@ -175,6 +179,14 @@ impl Canonical {
             return Some(name.to_string());
         }
         (sub == 0).then(|| "HighestSubIndexSupported".to_string())
+    }
+
+    /// Whether the standard defines subs 1 and up of object `index` as one
+    /// list of like entries (see [`NumberedRange::list`]).
+    pub(crate) fn is_list(self, index: u16) -> bool {
+        cia301::RANGES
+            .iter()
+            .any(|r| r.list && r.number(index).is_some())
     }
 
     /// Every object name of CiA 301 and this profile (present or not), in

@@ -389,8 +389,7 @@ impl<B: Bus> Master<B> {
         E::Access: od::Read,
         E::Value: od::Scalar,
     {
-        let data = self.upload(node, E::INDEX, E::SUBINDEX)?;
-        Ok(od::decode_value::<E>(&data)?)
+        self.read_sub::<E>(node, E::SUBINDEX)
     }
 
     /// Writes `value` to entry `E` of `node`.
@@ -400,8 +399,7 @@ impl<B: Bus> Master<B> {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value)?;
-        self.download(node, E::INDEX, E::SUBINDEX, buf.get(..len).unwrap_or(&buf))
+        self.write_sub::<E>(node, E::SUBINDEX, value)
     }
 
     /// Reads the bytes of a string, DOMAIN or other byte-valued entry.
@@ -431,6 +429,81 @@ impl<B: Bus> Master<B> {
         E::Value: od::ByteValue,
     {
         self.download(node, E::INDEX, E::SUBINDEX, data)
+    }
+
+    /// Reads element `at` of an ARRAY of `node`: the run-time form of
+    /// [`Self::read`] with `A<SUB>`.
+    pub fn read_at<A>(&mut self, node: NodeId, at: od::Element<A>) -> Result<A::Value, Error>
+    where
+        A: od::Array,
+        A::Access: od::Read,
+        A::Value: od::Scalar,
+    {
+        self.read_sub::<A>(node, at.subindex())
+    }
+
+    /// Writes `value` to element `at` of an ARRAY of `node`.
+    pub fn write_at<A>(
+        &mut self,
+        node: NodeId,
+        at: od::Element<A>,
+        value: A::Value,
+    ) -> Result<(), Error>
+    where
+        A: od::Array,
+        A::Access: od::Write,
+        A::Value: od::Scalar,
+    {
+        self.write_sub::<A>(node, at.subindex(), value)
+    }
+
+    /// Reads the bytes of element `at` of a byte-valued ARRAY (DOMAIN,
+    /// strings).
+    pub fn read_bytes_at<A>(&mut self, node: NodeId, at: od::Element<A>) -> Result<Vec<u8>, Error>
+    where
+        A: od::Array,
+        A::Access: od::Read,
+        A::Value: od::ByteValue,
+    {
+        self.upload(node, A::INDEX, at.subindex())
+    }
+
+    /// Writes the bytes of element `at` of a byte-valued ARRAY.
+    pub fn write_bytes_at<A>(
+        &mut self,
+        node: NodeId,
+        at: od::Element<A>,
+        data: &[u8],
+    ) -> Result<(), Error>
+    where
+        A: od::Array,
+        A::Access: od::Write,
+        A::Value: od::ByteValue,
+    {
+        self.download(node, A::INDEX, at.subindex(), data)
+    }
+
+    /// Typed read of sub `sub` of `E`'s object (an entry's own, or an
+    /// array element's).
+    fn read_sub<E>(&mut self, node: NodeId, sub: u8) -> Result<E::Value, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::Scalar,
+    {
+        let data = self.upload(node, E::INDEX, sub)?;
+        Ok(od::decode_value::<E>(&data)?)
+    }
+
+    /// Typed write of sub `sub` of `E`'s object.
+    fn write_sub<E>(&mut self, node: NodeId, sub: u8, value: E::Value) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::Scalar,
+    {
+        let (buf, len) = encode::<E>(value)?;
+        self.download(node, E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
     }
 
     /// Configures a PDO of `node` as [`crate::pdo::blocking::configure_pdo`]

@@ -89,8 +89,13 @@ fn listing(device: &Device) -> String {
             &[&module, &format!("0x{index:04X}"), kind_text(m.object)],
         );
         for e in &m.entries {
-            let sub = e.entry.subindex;
-            let key = format!("0x{index:04X}.{sub}");
+            let (sub, last) = e.subs();
+            // An indexed type covers a range: `0x1003.1..254`.
+            let key = if e.is_indexed() {
+                format!("0x{index:04X}.{sub}..{last}")
+            } else {
+                format!("0x{index:04X}.{sub}")
+            };
             entry_lines(
                 &mut lines,
                 (index, i16::from(sub), &key),
@@ -213,10 +218,11 @@ fn entry_lines(
     let value_type = od_plan::value_type_path(&e.value, module, names, error_plans);
     let s = &entry.semantics;
     let unit = unit_text(s.unit.as_deref(), s.scale, s.offset);
+    let generics = if e.is_indexed() { "<SUB>" } else { "" };
     lines.push(
         k(),
         &[
-            &format!("{module}::{}", names.text(e.zst)),
+            &format!("{module}::{}{generics}", names.text(e.zst)),
             key,
             &value_type,
             entry.access.as_str(),

@@ -7,7 +7,7 @@ use proc_macro2::TokenStream;
 use quote::quote;
 
 use super::naming;
-use crate::ir::{Access, Entry, Origin};
+use crate::ir::{Access, Entry, Origin, Semantics};
 
 /// Source text made safe for Markdown: control characters become spaces and
 /// Markdown/HTML specials are backslash-escaped.
@@ -66,17 +66,46 @@ impl Doc {
         self
     }
 
-    /// "Defined at file:line." as its own paragraph.
-    pub(crate) fn origin(&mut self, origin: &Origin) -> &mut Doc {
-        if origin.file.is_empty() {
+    /// "Unit: mm, 0.1 per raw step, offset -40." of an entry with a unit or
+    /// scale.
+    pub(crate) fn unit(&mut self, s: &Semantics) -> &mut Doc {
+        if s.unit.is_none() && s.scale.is_none() {
             return self;
         }
-        let at = if origin.line > 0 {
-            format!("{}:{}", origin.file, origin.line)
-        } else {
-            origin.file.clone()
-        };
-        self.para(format!("Defined at {}.", text(&at)))
+        let mut line = String::from("Unit:");
+        if let Some(unit) = &s.unit {
+            line.push_str(&format!(" {}", text(unit)));
+        }
+        if let Some(scale) = s.scale {
+            line.push_str(&format!(", {scale} per raw step"));
+        }
+        if let Some(offset) = s.offset {
+            line.push_str(&format!(", offset {offset}"));
+        }
+        self.para(line)
+    }
+
+    /// "Defined at file:line." as its own paragraph.
+    pub(crate) fn origin(&mut self, origin: &Origin) -> &mut Doc {
+        self.facts_and_origin(&[], origin)
+    }
+
+    /// Facts (sentences of generated Markdown: "Default: 254") and "Defined
+    /// at file:line." as one closing paragraph.
+    pub(crate) fn facts_and_origin(&mut self, facts: &[String], origin: &Origin) -> &mut Doc {
+        let mut sentences: Vec<String> = facts.iter().map(|f| format!("{f}.")).collect();
+        if !origin.file.is_empty() {
+            let at = if origin.line > 0 {
+                format!("{}:{}", origin.file, origin.line)
+            } else {
+                origin.file.clone()
+            };
+            sentences.push(format!("Defined at {}.", text(&at)));
+        }
+        if sentences.is_empty() {
+            return self;
+        }
+        self.para(sentences.join(" "))
     }
 
     /// The `#[doc = "..."]` attributes (prettyplease prints them as `///`),

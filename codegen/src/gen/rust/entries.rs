@@ -25,6 +25,9 @@ pub(crate) struct EntryInfo {
     pub(crate) value: Option<Vec<Ident>>,
     /// The raw type, `None` when the entry has no fixed size.
     pub(crate) raw: Option<Prim>,
+    /// The entry's Rust name when it is fixed (canonical or pinned), for
+    /// the names made from it (PDO fields): `PositionActualValue`.
+    pub(crate) rust_name: Option<String>,
 }
 
 impl EntryInfo {
@@ -72,7 +75,7 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
         ));
         infos.insert(
             (object.index, e.entry.subindex),
-            info(cx, &path, &e.value, &od.root_names),
+            info(cx, &path, e, &od.root_names),
         );
     }
     for m in &od.modules {
@@ -80,6 +83,14 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
         let path = vec![super::naming::ident("od"), module.clone()];
         let mut inner = TokenStream::new();
         for e in &m.entries {
+            if e.is_indexed() {
+                inner.extend(super::arrays::items(cx, object, e, &m.names, &path));
+                let info = info(cx, &path, e, &m.names);
+                for element in &e.elements {
+                    infos.insert((object.index, element.subindex), info.clone());
+                }
+                continue;
+            }
             let ident = m.names.get(e.zst);
             inner.extend(entry_items(
                 cx,
@@ -93,7 +104,7 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
             ));
             infos.insert(
                 (object.index, e.entry.subindex),
-                info(cx, &path, &e.value, &m.names),
+                info(cx, &path, e, &m.names),
             );
         }
         let mut doc = Doc::new();
@@ -123,8 +134,9 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
     (items, infos)
 }
 
-fn info(cx: &Ctx, module: &[Ident], plan: &Plan, names: &Names) -> EntryInfo {
-    let (value, raw) = match plan {
+fn info(cx: &Ctx, module: &[Ident], e: &od_plan::EntryPlan, names: &Names) -> EntryInfo {
+    let rust_name = e.fixed_name.then(|| names.text(e.zst).to_string());
+    let (value, raw) = match &e.value {
         Plan::Prim(p) => (None, Some(*p)),
         Plan::Bytes(_) => (None, None),
         Plan::Error(i) => {
@@ -145,7 +157,11 @@ fn info(cx: &Ctx, module: &[Ident], plan: &Plan, names: &Names) -> EntryInfo {
             (Some(path), Some(*raw))
         }
     };
-    EntryInfo { value, raw }
+    EntryInfo {
+        value,
+        raw,
+        rust_name,
+    }
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -221,7 +237,7 @@ fn entry_items(
 }
 
 /// For a standard object: where its Rust name comes from.
-fn standard_para(cx: &Ctx, object: &Object, doc: &mut Doc) {
+pub(super) fn standard_para(cx: &Ctx, object: &Object, doc: &mut Doc) {
     if let Some(text) = crate::profiles::Canonical::of(cx.device).text(object.index) {
         doc.para(format!(
             "Standard object *{}*: named by its CiA name, whatever the source calls it.",
@@ -248,20 +264,7 @@ fn entry_doc(object: &Object, entry: &Entry, var: bool) -> Doc {
     if let Some(description) = &entry.semantics.description {
         doc.source_para(description);
     }
-    let s = &entry.semantics;
-    if s.unit.is_some() || s.scale.is_some() {
-        let mut line = String::from("Unit:");
-        if let Some(unit) = &s.unit {
-            line.push_str(&format!(" {}", docs::text(unit)));
-        }
-        if let Some(scale) = s.scale {
-            line.push_str(&format!(", {scale} per raw step"));
-        }
-        if let Some(offset) = s.offset {
-            line.push_str(&format!(", offset {offset}"));
-        }
-        doc.para(line);
-    }
+    doc.unit(&entry.semantics);
     let literal = |l: &Literal| docs::text(&l.text);
     let mut facts = Vec::new();
     if let Some(d) = &entry.default {
@@ -273,14 +276,15 @@ fn entry_doc(object: &Object, entry: &Entry, var: bool) -> Doc {
     if let Some(h) = &entry.high_limit {
         facts.push(format!("High limit: {}", literal(h)));
     }
-    if !facts.is_empty() {
-        doc.para(facts.join(". ") + ".");
-    }
-    doc.origin(&entry.origin);
+    doc.facts_and_origin(&facts, &entry.origin);
     doc
 }
 
-fn default_tokens(entry: &Entry, plan: &Plan, value_ty: &TokenStream) -> Option<TokenStream> {
+pub(super) fn default_tokens(
+    entry: &Entry,
+    plan: &Plan,
+    value_ty: &TokenStream,
+) -> Option<TokenStream> {
     let literal = entry.default.as_ref()?;
     if literal.plus_node_id {
         return None;
@@ -362,7 +366,7 @@ fn raw_literal(value: &Value, raw: Prim) -> Option<TokenStream> {
     }
 }
 
-fn access_tokens(rt: &TokenStream, access: Access) -> TokenStream {
+pub(super) fn access_tokens(rt: &TokenStream, access: Access) -> TokenStream {
     match access {
         Access::Ro => quote!(#rt::od::access::Ro),
         Access::Wo => quote!(#rt::od::access::Wo),

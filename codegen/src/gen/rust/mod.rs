@@ -17,6 +17,7 @@
 //! always gives the same bytes.
 
 mod api;
+mod arrays;
 mod bits;
 mod derives;
 mod docs;

@@ -2,15 +2,20 @@
 //! `od::ObjectInfo`), for code that works on the whole dictionary at run
 //! time, such as device simulators.
 
-use proc_macro2::TokenStream;
+use proc_macro2::{Ident, TokenStream};
 use quote::quote;
 
 use super::entries::data_type_tokens;
-use crate::ir::{Access, Device, Literal, ObjectKind, Value};
+use super::naming;
+use crate::ir::{Access, DataType, Device, Literal, ObjectKind, Value};
 
-/// The `OBJECTS` constant, sorted by index and subindex.
+/// The `OBJECTS` constant, sorted by index and subindex: one
+/// `ObjectInfo::new(..)` per entry, so that each entry is a line or two
+/// (the variants of the runtime's enums imported into the constant's
+/// block).
 pub(crate) fn emit(device: &Device, rt: &TokenStream) -> TokenStream {
     let mut rows = Vec::new();
+    let mut used = Used::default();
     for object in device.objects.values() {
         for entry in object.entries.values() {
             let index = super::prim::hex(u128::from(object.index));
@@ -20,7 +25,7 @@ pub(crate) fn emit(device: &Device, rt: &TokenStream) -> TokenStream {
             } else {
                 &entry.name
             };
-            let data_type = data_type_tokens(rt, entry.data_type);
+            let data_type = data_type_variant(entry.data_type);
             let access = match entry.access {
                 Access::Ro => quote!(Ro),
                 Access::Wo => quote!(Wo),
@@ -30,44 +35,83 @@ pub(crate) fn emit(device: &Device, rt: &TokenStream) -> TokenStream {
                 Access::Const => quote!(Const),
             };
             let mappable = entry.pdo_mappable;
-            let default = option(entry.default.as_ref().and_then(|l| default_tokens(l, rt)));
-            let low = option(
-                entry
-                    .low_limit
-                    .as_ref()
-                    .and_then(|l| number_tokens(&l.value, rt)),
-            );
-            let high = option(
-                entry
-                    .high_limit
-                    .as_ref()
-                    .and_then(|l| number_tokens(&l.value, rt)),
-            );
-            rows.push(quote! {
-                #rt::od::ObjectInfo {
-                    index: #index,
-                    subindex: #sub,
-                    name: #name,
-                    data_type: #data_type,
-                    access: #rt::od::AccessRight::#access,
-                    pdo_mappable: #mappable,
-                    default: #default,
-                    low_limit: #low,
-                    high_limit: #high,
-                }
-            });
+            let mut row = quote!(O::new(#index, #sub, #name, #data_type, #access, #mappable));
+            if let Some((default, number)) = entry.default.as_ref().and_then(default_tokens) {
+                used.default = true;
+                used.number |= number;
+                row.extend(quote!(.with_default(#default)));
+            }
+            let limit = |l: &Option<Literal>| l.as_ref().and_then(|l| number_tokens(&l.value));
+            let (low, high) = (limit(&entry.low_limit), limit(&entry.high_limit));
+            if low.is_some() || high.is_some() {
+                used.number = true;
+                used.some = true;
+                used.none |= low.is_none() || high.is_none();
+                let (low, high) = (option(low), option(high));
+                row.extend(quote!(.with_limits(#low, #high)));
+            }
+            rows.push(row);
         }
     }
-    quote! {
-        #[doc = " Every entry as plain data (index, subindex, name, type, access, default, limits), sorted by index and subindex."]
-        pub const OBJECTS: &[#rt::od::ObjectInfo] = &[#(#rows,)*];
+    let doc = " Every entry as plain data (index, subindex, name, type, access, default, limits), sorted by index and subindex.";
+    if rows.is_empty() {
+        return quote! {
+            #[doc = #doc]
+            pub const OBJECTS: &[#rt::od::ObjectInfo] = &[];
+        };
     }
+    // Only what the rows use is imported (an unused import warns).
+    let option: Vec<Ident> = [("None", used.none), ("Some", used.some)]
+        .into_iter()
+        .filter(|(_, used)| *used)
+        .map(|(name, _)| naming::ident(name))
+        .collect();
+    let option = (!option.is_empty()).then(|| quote!(use ::core::option::Option::{#(#option),*};));
+    let mut od = vec![quote!(AccessRight::*), quote!(DataType::*)];
+    if used.default {
+        od.push(quote!(DefaultValue::*));
+    }
+    if used.number {
+        od.push(quote!(Number::*));
+    }
+    od.push(quote!(ObjectInfo as O));
+    quote! {
+        #[doc = #doc]
+        pub const OBJECTS: &[#rt::od::ObjectInfo] = {
+            #option
+            use #rt::od::{#(#od),*};
+            &[#(#rows,)*]
+        };
+    }
+}
+
+/// The imports the rows need.
+#[derive(Default)]
+struct Used {
+    /// `DefaultValue` variants.
+    default: bool,
+    /// `Number` variants.
+    number: bool,
+    some: bool,
+    none: bool,
+}
+
+/// The `DataType` variant of a data type, as imported into `OBJECTS`.
+fn data_type_variant(data_type: DataType) -> TokenStream {
+    let path = data_type_tokens(&quote!(rt), data_type);
+    // `rt::od::DataType::Unsigned8` without its path.
+    let tokens: Vec<proc_macro2::TokenTree> = path.into_iter().collect();
+    let last_ident = tokens
+        .iter()
+        .rposition(|t| matches!(t, proc_macro2::TokenTree::Ident(_)))
+        .expect("a variant");
+    tokens[last_ident..].iter().cloned().collect()
 }
 
 fn option(tokens: Option<TokenStream>) -> TokenStream {
     match tokens {
-        Some(t) => quote!(::core::option::Option::Some(#t)),
-        None => quote!(::core::option::Option::None),
+        Some(t) => quote!(Some(#t)),
+        None => quote!(None),
     }
 }
 
@@ -76,11 +120,11 @@ fn int_tokens(v: i128) -> TokenStream {
     if v < 0 { quote!(-#lit) } else { quote!(#lit) }
 }
 
-fn number_tokens(value: &Value, rt: &TokenStream) -> Option<TokenStream> {
+fn number_tokens(value: &Value) -> Option<TokenStream> {
     match value {
         Value::Integer(v) => {
             let v = int_tokens(*v);
-            Some(quote!(#rt::od::Number::Int(#v)))
+            Some(quote!(Int(#v)))
         }
         Value::Real(f) if f.is_finite() => {
             let lit = proc_macro2::Literal::f64_unsuffixed(f.abs());
@@ -89,29 +133,30 @@ fn number_tokens(value: &Value, rt: &TokenStream) -> Option<TokenStream> {
             } else {
                 quote!(#lit)
             };
-            Some(quote!(#rt::od::Number::Real(#v)))
+            Some(quote!(Real(#v)))
         }
         _ => None,
     }
 }
 
-fn default_tokens(literal: &Literal, rt: &TokenStream) -> Option<TokenStream> {
+/// A default's `DefaultValue`, and whether it is a `Number`.
+fn default_tokens(literal: &Literal) -> Option<(TokenStream, bool)> {
     match &literal.value {
         Value::Integer(v) if literal.plus_node_id => {
             let v = int_tokens(*v);
-            Some(quote!(#rt::od::DefaultValue::NodeRelative(#v)))
+            Some((quote!(NodeRelative(#v)), false))
         }
         Value::Text(text) => {
             let bytes = proc_macro2::Literal::byte_string(text.as_bytes());
-            Some(quote!(#rt::od::DefaultValue::Bytes(#bytes)))
+            Some((quote!(Bytes(#bytes)), false))
         }
         Value::Bytes(bytes) => {
             let bytes = proc_macro2::Literal::byte_string(bytes);
-            Some(quote!(#rt::od::DefaultValue::Bytes(#bytes)))
+            Some((quote!(Bytes(#bytes)), false))
         }
         value => {
-            let number = number_tokens(value, rt)?;
-            Some(quote!(#rt::od::DefaultValue::Number(#number)))
+            let number = number_tokens(value)?;
+            Some((quote!(Number(#number)), true))
         }
     }
 }

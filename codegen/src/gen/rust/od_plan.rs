@@ -9,7 +9,7 @@ use std::collections::BTreeMap;
 use proc_macro2::Ident;
 
 use super::errors::{self, ErrorPlan};
-use super::naming::{Case, NameId, Names, Namespace};
+use super::naming::{self, Case, NameId, Names, Namespace};
 use super::values::{self, Plan};
 use crate::diag::Diagnostics;
 use crate::ir::{Device, Entry, Object, ObjectKind};
@@ -17,9 +17,32 @@ use crate::profiles::Canonical;
 
 /// One entry's names: its zero-sized type and its value type's plan.
 pub(crate) struct EntryPlan<'d> {
+    /// The entry; for an indexed type, its first element (every element has
+    /// the same type facts and semantics).
     pub(crate) entry: &'d Entry,
     pub(crate) zst: NameId,
     pub(crate) value: Plan,
+    /// For the elements of an ARRAY as one type indexed by sub-index
+    /// (`PreDefinedErrorField<SUB>`): every element, in sub-index order, a
+    /// contiguous run. Empty for a type of one entry.
+    pub(crate) elements: Vec<&'d Entry>,
+    /// Whether `zst` is a fixed name (canonical or pinned), which other
+    /// names made from the entry (PDO fields) follow instead of the source.
+    pub(crate) fixed_name: bool,
+}
+
+impl EntryPlan<'_> {
+    /// The sub-indices the type stands for: `(first, last)`.
+    pub(crate) fn subs(&self) -> (u8, u8) {
+        match (self.elements.first(), self.elements.last()) {
+            (Some(first), Some(last)) => (first.subindex, last.subindex),
+            _ => (self.entry.subindex, self.entry.subindex),
+        }
+    }
+
+    pub(crate) fn is_indexed(&self) -> bool {
+        !self.elements.is_empty()
+    }
 }
 
 /// A VAR (or DOMAIN) object: its entry's types live in `od` itself.
@@ -101,10 +124,17 @@ pub(crate) fn plan<'d>(
                     values::Name::Source(&entry.name),
                 ),
             };
+            let fixed_name = matches!(name, values::Name::Fixed(_));
             let value = values::plan(entry, name, error_plan(device, errors, entry), &mut types);
             root.push(RootPlan {
                 object,
-                entry: EntryPlan { entry, zst, value },
+                entry: EntryPlan {
+                    entry,
+                    zst,
+                    value,
+                    elements: Vec::new(),
+                    fixed_name,
+                },
             });
         } else {
             let id = match (&object.rust_name, &fixed) {
@@ -123,9 +153,12 @@ pub(crate) fn plan<'d>(
             let module = module_names.get(id);
             let mut ns = Namespace::new(format!("module `od::{module}`"), Case::UpperCamel);
             ns.reserve_constructor_names();
-            let entries: Vec<EntryPlan> = object
+            let elements = indexed_elements(object, &canonical, standard);
+            let singles = object
                 .entries
                 .values()
+                .filter(|e| !elements.iter().any(|el| el.subindex == e.subindex));
+            let mut entries: Vec<EntryPlan> = singles
                 .map(|entry| {
                     let key = format!("sub {}", entry.subindex);
                     let fixed = standard
@@ -145,11 +178,53 @@ pub(crate) fn plan<'d>(
                             values::Name::Source(&entry.name),
                         ),
                     };
+                    let fixed_name = matches!(name, values::Name::Fixed(_));
                     let value =
                         values::plan(entry, name, error_plan(device, errors, entry), &mut ns);
-                    EntryPlan { entry, zst, value }
+                    EntryPlan {
+                        entry,
+                        zst,
+                        value,
+                        elements: Vec::new(),
+                        fixed_name,
+                    }
                 })
                 .collect();
+            if let Some(&first) = elements.first() {
+                // The indexed type is named like its object, whatever its
+                // elements are called: the object's pin, canonical or
+                // source name.
+                let (first_sub, last_sub) = (first.subindex, elements[elements.len() - 1].subindex);
+                let key = format!("subs {first_sub}..{last_sub}");
+                let (zst, name) = match (&object.rust_name, &fixed_names(&canonical, object)) {
+                    (Some(pin), _) => {
+                        let camel = naming::sanitize(pin, Case::UpperCamel);
+                        (ns.request_fixed(&camel, &key, Some(&object.origin)), camel)
+                    }
+                    (None, Some(name)) => (
+                        ns.request_fixed(name, &key, Some(&object.origin)),
+                        name.clone(),
+                    ),
+                    (None, None) => (
+                        ns.request(&object.name, &key, Some(&object.origin)),
+                        object.name.clone(),
+                    ),
+                };
+                let value = values::plan(
+                    first,
+                    values::Name::Fixed(&name),
+                    error_plan(device, errors, first),
+                    &mut ns,
+                );
+                entries.push(EntryPlan {
+                    entry: first,
+                    zst,
+                    value,
+                    elements,
+                    // Elements are told apart by their own names.
+                    fixed_name: false,
+                });
+            }
             ns.reserve("INDEX");
             let names = ns.resolve(diags);
             ModulePlan {
@@ -166,6 +241,86 @@ pub(crate) fn plan<'d>(
         root_names,
         modules,
     }
+}
+
+/// The canonical name of a standard object (of the device's profiles).
+fn fixed_names(canonical: &Canonical, object: &Object) -> Option<String> {
+    canonical.object(object.index)
+}
+
+/// The elements of an ARRAY (or of a standard object whose subs the
+/// standard defines as one list: the PDO mapping parameters, whatever
+/// object code the source gives) that become one type indexed by
+/// sub-index: every sub from 1 up, when they are a contiguous run that shares data
+/// type, access right, PDO mappability and meaning (unit, scale, named
+/// values, bit fields, error table; descriptions may differ) and none has a
+/// `rust_name:` pin. Subs with a canonical name of their own come first and
+/// keep their types (0x1010's `SaveAllParameters`, …; the elements are the
+/// manufacturer's subs after them). Otherwise none: the subs keep one type
+/// each, like a RECORD's.
+fn indexed_elements<'d>(
+    object: &'d Object,
+    canonical: &Canonical,
+    standard: bool,
+) -> Vec<&'d Entry> {
+    let list = object.kind == ObjectKind::Array || (standard && canonical.is_list(object.index));
+    if !list {
+        return Vec::new();
+    }
+    // Subs the standard names keep their own types; the elements are the
+    // subs after them (0x1029: sub 1 `CommunicationError`, subs 2 and up
+    // the profile's or vendor's errors).
+    let named = |e: &Entry| standard && canonical.sub(object.index, e.subindex).is_some();
+    let elements: Vec<&Entry> = object
+        .entries
+        .values()
+        .filter(|e| e.subindex >= 1)
+        .skip_while(|e| named(e))
+        .collect();
+    let Some(first) = elements.first() else {
+        return Vec::new();
+    };
+    let contiguous = elements
+        .iter()
+        .zip(u16::from(first.subindex)..)
+        .all(|(e, sub)| u16::from(e.subindex) == sub);
+    let meaning = |e: &Entry| meaning(&e.semantics);
+    let first_meaning = meaning(first);
+    let uniform = elements.iter().all(|e| {
+        e.data_type == first.data_type
+            && e.access == first.access
+            && e.pdo_mappable == first.pdo_mappable
+            && e.rust_name.is_none()
+            && !named(e)
+            && meaning(e) == first_meaning
+    });
+    if contiguous && uniform {
+        elements
+    } else {
+        Vec::new()
+    }
+}
+
+/// What a value means, without the words around it: the semantics without
+/// description and origins.
+fn meaning(s: &crate::ir::Semantics) -> crate::ir::Semantics {
+    let mut s = s.clone();
+    s.description = None;
+    let plain = crate::ir::Origin::default;
+    let values = |t: &mut Option<crate::ir::ValueTable>| {
+        for v in t.iter_mut().flat_map(|t| t.named.iter_mut()) {
+            v.origin = plain();
+        }
+    };
+    values(&mut s.values);
+    for b in &mut s.bits {
+        b.origin = plain();
+        values(&mut b.values);
+    }
+    for p in &mut s.patterns {
+        p.origin = plain();
+    }
+    s
 }
 
 /// The path of an entry's value type as planned (`u16`,
@@ -238,17 +393,24 @@ pub(crate) fn device_names(device: &Device) -> DeviceNames {
     for m in &od.modules {
         let module = format!("od::{}", m.module);
         for e in &m.entries {
-            if let Some(shared) = m.module_collided.as_ref() {
-                out.collided
-                    .insert((m.object.index, e.entry.subindex), vec![shared.clone()]);
+            let value = value_type(&e.value, &module, &m.names);
+            let ty = m.names.text(e.zst);
+            let subs: Vec<(u8, String)> = if e.is_indexed() {
+                e.elements
+                    .iter()
+                    .map(|el| (el.subindex, format!("{module}::{ty}<{}>", el.subindex)))
+                    .collect()
+            } else {
+                vec![(e.entry.subindex, format!("{module}::{ty}"))]
+            };
+            for (sub, path) in subs {
+                if let Some(shared) = m.module_collided.as_ref() {
+                    out.collided
+                        .insert((m.object.index, sub), vec![shared.clone()]);
+                }
+                out.entries
+                    .insert((m.object.index, sub), (path, value.clone()));
             }
-            out.entries.insert(
-                (m.object.index, e.entry.subindex),
-                (
-                    format!("{module}::{}", m.names.text(e.zst)),
-                    value_type(&e.value, &module, &m.names),
-                ),
-            );
         }
         out.modules.insert(m.object.index, module);
     }

@@ -224,8 +224,10 @@ fn layout<'a>(
         } else {
             &mapped.name
         };
+        // A standard or pinned entry's field follows its Rust name
+        // (`position_actual_value` whatever the vendor calls 0x6064).
         let name_id = fields_ns.request(
-            source,
+            info.rust_name.as_deref().unwrap_or(source),
             &format!("x{:04X} sub {}", target.index, target.subindex),
             Some(&mapped.origin),
         );

@@ -30,7 +30,7 @@ impl LinakTechline {
     /// producer and a time, and no loss is pending.
     pub(super) fn heartbeat_ok(&self, ctx: Ctx<'_, '_>) -> bool {
         let configured = ctx
-            .get::<consumer_heartbeat_time::ConsumerHeartbeatTime>()
+            .get::<consumer_heartbeat_time::ConsumerHeartbeatTime<1>>()
             .is_some_and(|v| v.node_id() != 0 && v.heartbeat_time() != 0);
         configured && !self.heartbeat_lost
     }
