@@ -206,7 +206,25 @@ fn doc(cx: &Ctx, object: &Object, plan: &EntryPlan, ident: &Ident, form: &NameFo
         }
     }
     doc.unit(&first.semantics);
-    facts(&mut doc, elements, form, &first.origin);
+    let last = elements[elements.len() - 1];
+    if last.origin == first.origin {
+        facts(&mut doc, elements, form, &first.origin);
+    } else {
+        // Each element's section: the first and the last say where.
+        let end = if last.origin.file == first.origin.file {
+            format!("line {}", last.origin.line)
+        } else {
+            format!("{}:{}", last.origin.file, last.origin.line)
+        };
+        let origin = Origin {
+            file: format!(
+                "{}:{} (sub {}) to {end} (sub {})",
+                first.origin.file, first.origin.line, first.subindex, last.subindex
+            ),
+            line: 0,
+        };
+        facts(&mut doc, elements, form, &origin);
+    }
     doc
 }
 
