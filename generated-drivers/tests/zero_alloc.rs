@@ -145,8 +145,22 @@ macro_rules! enc {
     };
 }
 
+/// A `#[derive(Pdo)]` struct: 12 bits of the statusword, 4 signed bits of
+/// the mode display, the position; every one of its 48 bits a field's.
+#[derive(eds2rust_drivers::runtime::Pdo, Debug, Clone, Copy, PartialEq)]
+#[pdo(tpdo = 4, runtime = eds2rust_drivers::runtime)]
+struct Packed {
+    #[pdo(entry = ir::od::Statusword, bits = 12)]
+    status: <ir::od::Statusword as eds2rust_drivers::runtime::od::Entry>::Value,
+    #[pdo(entry = ir::od::ModesOfOperationDisplay, bits = 4)]
+    mode: ir::od::ModesOfOperationDisplayValue,
+    #[pdo(entry = ir::od::PositionActualValue)]
+    position: ir::od::PositionActualValueValue,
+}
+
 fn all_pdos() -> u64 {
     let mut sum = 0;
+    sum += exercise::<Packed>(15, enc!(Packed));
     sum += exercise::<lk::pdo::Rpdo1Command>(1, enc!(lk::pdo::Rpdo1Command));
     sum += exercise::<lk::pdo::Tpdo1Feedback>(2, enc!(lk::pdo::Tpdo1Feedback));
     sum += exercise::<lk::pdo::Tpdo2ParallelFeedback>(3, enc!(lk::pdo::Tpdo2ParallelFeedback));

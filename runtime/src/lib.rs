@@ -52,6 +52,10 @@ pub mod tokio;
 #[cfg(feature = "std")]
 pub mod transport;
 
+/// `#[derive(Pdo)]`: a custom PDO mapping as a struct of mapped entries
+/// (docs/custom-pdos.md).
+#[cfg(feature = "derive")]
+pub use eds2rust_derive::Pdo;
 pub use frame::{CanId, Frame};
 pub use time::{Deadline, Instant};
 

@@ -267,9 +267,9 @@ pub trait Scalar: Copy {
 macro_rules! scalar_ints {
     ($($ty:ty),*) => {$(
         impl Scalar for $ty {
-            #[inline]
+            #[inline(always)]
             fn to_raw(self) -> u64 { self as u64 }
-            #[inline]
+            #[inline(always)]
             fn from_raw(raw: u64) -> Self { raw as $ty }
         }
     )*};

@@ -24,6 +24,9 @@ use core::fmt;
 use crate::od;
 
 mod config;
+#[doc(hidden)]
+pub mod derive;
+pub mod layout;
 mod receiver;
 mod transmitter;
 

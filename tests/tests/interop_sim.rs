@@ -296,3 +296,155 @@ fn interroll_tpdos_read_and_decode_alike() {
     ];
     assert_eq!(values, &ours, "data {data:02X?}");
 }
+
+/// A custom TPDO and RPDO declared with `#[derive(Pdo)]` for the Interroll
+/// drive's free PDO 4 (chapter 8: "can be used freely"): configured on the
+/// simulator with the runtime's `configure_pdo` (CiA 301 order, read-back)
+/// over the in-process virtual bus, the RPDO applied by the device, the
+/// TPDO received and decoded into the struct; then the same simulator (same
+/// store, same clock) on python-canopen's bus, where `RemoteNode` reads the
+/// mapping back over SDO (`tpdo.read(from_od=False)`) and decodes a TPDO
+/// to the values the derived struct gives for the same bytes.
+#[test]
+fn derived_pdos_are_configured_and_read_back_by_python() {
+    use eds2rust_runtime::Pdo;
+    use eds2rust_runtime::blocking::SdoClient;
+    use eds2rust_runtime::od::Entry;
+    use eds2rust_runtime::pdo::PdoConfig;
+    use eds2rust_runtime::sdo::Channel;
+    use eds2rust_runtime::sdo::client::ClientConfig;
+    use eds2rust_runtime::transport::Bus;
+    use eds2rust_runtime::transport::virtual_bus::VirtualBus;
+    use eds2rust_runtime::{CanId, Frame};
+    use interroll_ec5000bi::od;
+
+    #[derive(Pdo, Debug, Clone, Copy, PartialEq)]
+    #[pdo(tpdo = 4)]
+    struct StatusVelocity {
+        #[pdo(entry = od::Statusword)]
+        status: <od::Statusword as Entry>::Value,
+        #[pdo(entry = od::VelocityActualValue)]
+        velocity: od::VelocityActualValueValue,
+        #[pdo(entry = od::ModesOfOperationDisplay)]
+        mode: od::ModesOfOperationDisplayValue,
+    }
+
+    #[derive(Pdo, Debug, Clone, Copy, PartialEq)]
+    #[pdo(rpdo = 4)]
+    struct ControlVelocity {
+        #[pdo(entry = od::Controlword)]
+        control: <od::Controlword as Entry>::Value,
+        #[pdo(entry = od::TargetVelocity)]
+        velocity: od::TargetVelocityValue,
+    }
+
+    let id = interroll_ec5000bi::DEFAULT_NODE_ID;
+    let drive = node(id);
+    let clock = Clock::new();
+    let device = models::interroll_ec5000bi::simulator(clock.now());
+
+    // Phase 1: the runtime configures both PDOs on the in-process bus.
+    let bus = VirtualBus::new();
+    let mut device_port = bus.attach();
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let serving = std::thread::spawn(move || {
+        let mut device = device;
+        blocking::serve(&mut device_port, &clock, &mut device, &flag, None, |_| {})
+            .expect("the simulator's bus");
+        device
+    });
+    let mut sdo = SdoClient::new(bus.attach(), ClientConfig::new(Channel::default_for(drive)));
+    let mut watch = bus.attach();
+    let tpdo = PdoConfig::from_pdo::<StatusVelocity>(drive)
+        .expect("TPDO4 has a predefined COB-ID")
+        .with_transmission_type(255)
+        .with_event_timer(20);
+    eds2rust_runtime::pdo::blocking::configure_pdo(&mut sdo, &tpdo).expect("TPDO4 configured");
+    let rpdo = PdoConfig::from_pdo::<ControlVelocity>(drive)
+        .expect("RPDO4 has a predefined COB-ID")
+        .with_transmission_type(255);
+    eds2rust_runtime::pdo::blocking::configure_pdo(&mut sdo, &rpdo).expect("RPDO4 configured");
+    assert_eq!(sdo.upload(0x1A03, 0).expect("0x1A03 sub 0"), [3]);
+    assert_eq!(
+        sdo.upload(0x1A03, 2).expect("0x1A03 sub 2"),
+        0x606C_0020u32.to_le_bytes()
+    );
+
+    // Operational: an RPDO4 from the master is written into 0x6040/0x60FF.
+    let start = Frame::new(CanId::Standard(0x000), &[0x01, id]).expect("NMT start");
+    watch.send(&start).expect("send NMT start");
+    let command = ControlVelocity {
+        control: <od::Controlword as Entry>::Value::from_raw(0x0006),
+        velocity: od::TargetVelocityValue::from_raw(1200),
+    };
+    let cob = ControlVelocity::can_id(drive) as u16;
+    let frame = Frame::new(CanId::Standard(cob), &command.encode()).expect("RPDO4 frame");
+    std::thread::sleep(Duration::from_millis(50));
+    watch.send(&frame).expect("send RPDO4");
+    std::thread::sleep(Duration::from_millis(50));
+    assert_eq!(
+        sdo.read::<od::TargetVelocity>().expect("0x60FF"),
+        command.velocity
+    );
+    assert_eq!(
+        sdo.read::<od::Controlword>().expect("0x6040"),
+        command.control
+    );
+
+    // TPDO4 frames (event timer 20 ms) decode into the derived struct, and
+    // come to agree with the objects read over SDO (the drive has left
+    // "switch on disabled" on the shutdown command; TPDOs sent before that
+    // still say so).
+    let status = sdo.read::<od::Statusword>().expect("0x6041");
+    let mode = sdo.read::<od::ModesOfOperationDisplay>().expect("0x6061");
+    let cob = StatusVelocity::can_id(drive) as u16;
+    let deadline = StdInstant::now() + Duration::from_secs(3);
+    let mut last = None;
+    loop {
+        assert!(
+            StdInstant::now() < deadline,
+            "no TPDO4 with statusword {status:?} on the in-process bus; last {last:?}"
+        );
+        if let Some(f) = watch.recv(Duration::from_millis(100)).expect("receive") {
+            if f.id() == CanId::Standard(cob) {
+                let p = StatusVelocity::decode(f.data()).expect("TPDO4 length");
+                last = Some(p);
+                if p.status == status {
+                    assert_eq!(p.mode, mode);
+                    break;
+                }
+            }
+        }
+    }
+    stop.store(true, Ordering::Relaxed);
+    let device = serving.join().expect("the simulator thread");
+
+    // Phase 2: python-canopen reads the mapping back and decodes a TPDO4.
+    let py = PyPeer::spawn().unwrap_or_else(|e| panic!("{e}"));
+    let eds = export_eds("interroll_ec5000bi");
+    let mut py_port = py.port();
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let serving = std::thread::spawn(move || {
+        let mut device = device;
+        blocking::serve(&mut py_port, &clock, &mut device, &flag, None, |_| {})
+    });
+    start_node(&py, id, &eds);
+    let maps = read_maps(&py, id);
+    check_map::<StatusVelocity>(&maps, 4, drive);
+    let received = start_and_receive(&py, id, &[4], false);
+    let (data, values) = &received[0];
+    let p = StatusVelocity::decode(data).expect("TPDO4 length");
+    let ours = [
+        i128::from(p.status.to_raw()),
+        i128::from(p.velocity.to_raw()),
+        i128::from(p.mode.to_raw()),
+    ];
+    assert_eq!(values, &ours, "data {data:02X?}");
+    stop.store(true, Ordering::Relaxed);
+    serving
+        .join()
+        .expect("the simulator thread")
+        .expect("the simulator's bus");
+}

@@ -388,57 +388,20 @@ fn emit_struct(
             quote!(#[doc(alias = #source)])
         });
         defs.push(quote!(#[doc = #field_doc] #alias pub #name: #ty));
-        let mask = if f.width == 64 {
-            u64::MAX
-        } else {
-            (1u64 << f.width) - 1
-        };
-        let mask_lit = prim::hex(u128::from(mask));
-        let shift = Literal::u32_unsuffixed(f.offset);
-        let needs_mask = f.offset + f.width < 64;
-        let extract = match (f.offset == 0, needs_mask) {
-            (true, false) => quote!(word),
-            (true, true) => quote!((word & #mask_lit)),
-            (false, false) => quote!((word >> #shift)),
-            (false, true) => quote!((word >> #shift & #mask_lit)),
-        };
-        let raw_expr = prim::from_bits(f.raw, extract, f.width);
-        decodes.push(match &f.info.value {
-            Some(_) => quote!(#name: #ty::from_raw(#raw_expr)),
-            None => quote!(#name: #raw_expr),
+        // The one PDO codec (the runtime's `pdo::layout`, which
+        // `#[derive(Pdo)]` expands to as well), with constant offsets.
+        let offset = Literal::u32_unsuffixed(f.offset);
+        let width = Literal::u32_unsuffixed(f.width);
+        let signed = f.raw.is_signed();
+        decodes.push(quote! {
+            #name: <#ty as #rt::od::Scalar>::from_raw(
+                #rt::pdo::layout::get(word, #offset, #width, #signed)
+            )
         });
-        let value = match &f.info.value {
-            Some(_) => quote!(self.#name.to_raw()),
-            None => quote!(self.#name),
-        };
-        let bits_expr = prim::to_bits(f.raw, value);
-        let prim_bits = match f.raw {
-            Prim::Bool => 1,
-            Prim::U8 => 8,
-            Prim::U16 => 16,
-            Prim::U32 => 32,
-            _ => 64,
-        };
-        let masked = f.width < 64 && (f.raw.is_signed() || f.raw.is_float() || prim_bits > f.width);
-        encodes.push(match (f.offset == 0, masked) {
-            (true, false) => quote!(word |= #bits_expr;),
-            (true, true) => quote!(word |= #bits_expr & #mask_lit;),
-            (false, false) => quote!(word |= (#bits_expr) << #shift;),
-            (false, true) => quote!(word |= (#bits_expr & #mask_lit) << #shift;),
+        encodes.push(quote! {
+            word = #rt::pdo::layout::put(word, #offset, #width, #rt::od::Scalar::to_raw(self.#name));
         });
     }
-    let byte_idx: Vec<Literal> = (0..len).map(Literal::usize_unsuffixed).collect();
-    let zeros = (len..8).map(|_| quote!(0));
-    let word_from_bytes = if len == 8 {
-        quote!(u64::from_le_bytes(bytes))
-    } else {
-        quote!(u64::from_le_bytes([#(bytes[#byte_idx],)* #(#zeros,)*]))
-    };
-    let bytes_from_word = if len == 8 {
-        quote!(word.to_le_bytes())
-    } else {
-        quote!(let bytes = word.to_le_bytes(); [#(bytes[#byte_idx],)*])
-    };
     let derives = super::derives::attr(super::derives::PDO, float);
     let cob_default = comm_default(1);
     let cob = cob_id_items(cob_default, rt);
@@ -462,17 +425,14 @@ fn emit_struct(
             #cob
             #[doc = #decode_doc]
             #[inline] pub fn decode(data: &[u8]) -> ::core::result::Result<Self, #rt::od::PdoLengthError> {
-                let ::core::result::Result::Ok(bytes) = <[u8; #len_lit] as ::core::convert::TryFrom<&[u8]>>::try_from(data) else {
-                    return ::core::result::Result::Err(#rt::od::PdoLengthError { expected: #len_lit, actual: data.len() });
-                };
-                let word = #word_from_bytes;
+                let word = #rt::pdo::layout::load::<#len_lit>(data)?;
                 ::core::result::Result::Ok(Self { #(#decodes,)* })
             }
             #[doc = #encode_doc]
             #[inline] pub fn encode(&self) -> [u8; #len_lit] {
                 let mut word = 0u64;
                 #(#encodes)*
-                #bytes_from_word
+                #rt::pdo::layout::store::<#len_lit>(word)
             }
         }
         impl #rt::od::Pdo for #ident {

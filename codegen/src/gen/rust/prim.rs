@@ -148,29 +148,6 @@ pub(crate) fn hex(value: u128) -> TokenStream {
     text.parse().unwrap_or_default()
 }
 
-/// An expression turning the `width`-bit field `bits: u64` (already shifted
-/// down and masked) into the raw type.
-pub(crate) fn from_bits(prim: Prim, bits: TokenStream, width: u32) -> TokenStream {
-    match prim {
-        Prim::Bool => quote!(#bits != 0),
-        Prim::F32 => quote!(f32::from_bits(#bits as u32)),
-        Prim::F64 => quote!(f64::from_bits(#bits)),
-        p if p.is_signed() && width < 64 => {
-            let ty = p.tokens();
-            let shift = proc_macro2::Literal::u32_unsuffixed(64 - width);
-            quote!((((#bits << #shift) as i64) >> #shift) as #ty)
-        }
-        p => {
-            let ty = p.tokens();
-            if p == Prim::U64 {
-                bits
-            } else {
-                quote!(#bits as #ty)
-            }
-        }
-    }
-}
-
 /// An expression turning a raw value into its bit pattern as `u64`
 /// (unmasked: signed values are sign-extended).
 pub(crate) fn to_bits(prim: Prim, raw: TokenStream) -> TokenStream {

@@ -350,11 +350,11 @@ pub(crate) fn scalar_impl(rt: &TokenStream, name: &Ident, raw: Prim) -> TokenStr
     };
     quote! {
         impl #rt::od::Scalar for #name {
-            #[inline]
+            #[inline(always)]
             fn to_raw(self) -> u64 {
                 #to
             }
-            #[inline]
+            #[inline(always)]
             fn from_raw(raw: u64) -> Self {
                 Self::from_raw(#from)
             }

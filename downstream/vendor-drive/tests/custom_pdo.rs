@@ -1,0 +1,113 @@
+//! A custom mapping for the vendor drive, declared with `#[derive(Pdo)]`
+//! over its generated objects, as an integrator writes it: statusword and
+//! position actual value in TPDO2, controlword and target velocity in
+//! RPDO1. Configured with `configure_pdo` (CiA 301 order, read-back) on a
+//! simulated drive built from the DCF's own object table, on the
+//! in-process virtual bus; the RPDO is applied by the drive and the TPDO
+//! received and decoded into the struct.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant as WallClock};
+
+use eds2rust_runtime::blocking::{self, SdoClient};
+use eds2rust_runtime::od::{Entry, NodeId, Pdo as _};
+use eds2rust_runtime::pdo::PdoConfig;
+use eds2rust_runtime::pdo::blocking::configure_pdo;
+use eds2rust_runtime::sdo::Channel;
+use eds2rust_runtime::sdo::client::ClientConfig;
+use eds2rust_runtime::transport::virtual_bus::VirtualBus;
+use eds2rust_runtime::transport::{Bus, Clock};
+use eds2rust_runtime::{CanId, Frame, Pdo};
+use eds2rust_sim::{Device, DeviceConfig};
+use vendor_drive::drive::od;
+
+#[derive(Pdo, Debug, Clone, Copy, PartialEq)]
+#[pdo(tpdo = 2)]
+pub struct StatusPosition {
+    #[pdo(entry = od::Statusword)]
+    pub status: <od::Statusword as Entry>::Value,
+    #[pdo(entry = od::PositionActualValue)]
+    pub position: <od::PositionActualValue as Entry>::Value,
+    #[pdo(entry = od::ModesOfOperation)]
+    pub mode: <od::ModesOfOperation as Entry>::Value,
+}
+
+#[derive(Pdo, Debug, Clone, Copy, PartialEq)]
+#[pdo(rpdo = 1)]
+pub struct ControlVelocity {
+    #[pdo(entry = od::Controlword)]
+    pub control: <od::Controlword as Entry>::Value,
+    #[pdo(entry = od::TargetVelocity)]
+    pub velocity: <od::TargetVelocity as Entry>::Value,
+}
+
+#[test]
+fn configured_over_sdo_applied_and_received() {
+    let drive = NodeId::new(3).unwrap();
+    let clock = Clock::new();
+    let bus = VirtualBus::new();
+    let mut port = bus.attach();
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let serving = std::thread::spawn(move || {
+        let mut device = Device::new(od::OBJECTS, DeviceConfig::node(drive), (), clock.now());
+        blocking::serve(&mut port, &clock, &mut device, &flag, None, |_| {})
+    });
+    let mut sdo = SdoClient::new(bus.attach(), ClientConfig::new(Channel::default_for(drive)));
+    let mut watch = bus.attach();
+
+    let tpdo = PdoConfig::from_pdo::<StatusPosition>(drive)
+        .unwrap()
+        .with_transmission_type(255)
+        .with_event_timer(10);
+    configure_pdo(&mut sdo, &tpdo).expect("TPDO2 configured");
+    let rpdo = PdoConfig::from_pdo::<ControlVelocity>(drive)
+        .unwrap()
+        .with_transmission_type(255);
+    configure_pdo(&mut sdo, &rpdo).expect("RPDO1 configured");
+    assert_eq!(sdo.upload(0x1A01, 0).unwrap(), [3]);
+    assert_eq!(sdo.upload(0x1A01, 1).unwrap(), 0x6041_0010u32.to_le_bytes());
+    assert_eq!(sdo.upload(0x1600, 0).unwrap(), [2]);
+    assert_eq!(sdo.upload(0x1600, 2).unwrap(), 0x60FF_0020u32.to_le_bytes());
+
+    // A value the TPDO will carry: the mode of operation, set over SDO.
+    sdo.write::<od::ModesOfOperation>(3).unwrap();
+    watch
+        .send(&Frame::new(CanId::Standard(0), &[0x01, drive.get()]).unwrap())
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(30));
+
+    // The RPDO is written into the drive's objects.
+    let command = ControlVelocity {
+        control: 0x000F,
+        velocity: -2500,
+    };
+    let id = ControlVelocity::can_id(drive) as u16;
+    watch
+        .send(&Frame::new(CanId::Standard(id), &command.encode()).unwrap())
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(30));
+    assert_eq!(sdo.read::<od::Controlword>().unwrap(), command.control);
+    assert_eq!(sdo.read::<od::TargetVelocity>().unwrap(), command.velocity);
+
+    // The TPDO arrives (event timer 10 ms) and decodes into the struct.
+    let id = StatusPosition::can_id(drive) as u16;
+    let deadline = WallClock::now() + Duration::from_secs(3);
+    let received = loop {
+        assert!(WallClock::now() < deadline, "no TPDO2");
+        if let Some(f) = watch.recv(Duration::from_millis(100)).unwrap() {
+            if f.id() == CanId::Standard(id) {
+                break StatusPosition::decode(f.data()).unwrap();
+            }
+        }
+    };
+    assert_eq!(received.mode, 3);
+    assert_eq!(received.status, sdo.read::<od::Statusword>().unwrap());
+    assert_eq!(received.position, sdo.read::<od::PositionActualValue>().unwrap());
+    assert_eq!(StatusPosition::LEN, 7);
+    assert_eq!(StatusPosition::MAPPING, [0x6041_0010, 0x6064_0020, 0x6060_0008]);
+
+    stop.store(true, Ordering::Relaxed);
+    serving.join().unwrap().unwrap();
+}
