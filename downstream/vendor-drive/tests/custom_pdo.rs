@@ -1,10 +1,13 @@
 //! A custom mapping for the vendor drive, declared with `#[derive(Pdo)]`
-//! over its generated objects, as an integrator writes it: statusword and
-//! position actual value in TPDO2, controlword and target velocity in
-//! RPDO1. Configured with `configure_pdo` (CiA 301 order, read-back) on a
-//! simulated drive built from the DCF's own object table, on the
-//! in-process virtual bus; the RPDO is applied by the drive and the TPDO
-//! received and decoded into the struct.
+//! over its generated objects, as an integrator writes it: statusword,
+//! position actual value and mode of operation in TPDO2, controlword and
+//! target velocity in RPDO1. Configured with `configure_pdo` (CiA 301
+//! order, read-back) on a simulated drive built from the DCF's own object
+//! table, on the in-process virtual bus; the RPDO is applied by the drive
+//! and the TPDO received and decoded into the struct. Then the same drive
+//! (same store, same clock) on python-canopen's bus: `RemoteNode` with the
+//! vendor's DCF reads the mapping back over SDO (`tpdo.read(from_od=False)`)
+//! and decodes a TPDO2 to the values the struct gives for the same bytes.
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -20,6 +23,8 @@ use eds2rust_runtime::transport::virtual_bus::VirtualBus;
 use eds2rust_runtime::transport::{Bus, Clock};
 use eds2rust_runtime::{CanId, Frame, Pdo};
 use eds2rust_sim::{Device, DeviceConfig};
+use eds2rust_tests::peer::PyPeer;
+use serde_json::{Value, json};
 use vendor_drive::drive::od;
 
 #[derive(Pdo, Debug, Clone, Copy, PartialEq)]
@@ -52,7 +57,8 @@ fn configured_over_sdo_applied_and_received() {
     let flag = Arc::clone(&stop);
     let serving = std::thread::spawn(move || {
         let mut device = Device::new(od::OBJECTS, DeviceConfig::node(drive), (), clock.now());
-        blocking::serve(&mut port, &clock, &mut device, &flag, None, |_| {})
+        blocking::serve(&mut port, &clock, &mut device, &flag, None, |_| {}).unwrap();
+        device
     });
     let mut sdo = SdoClient::new(bus.attach(), ClientConfig::new(Channel::default_for(drive)));
     let mut watch = bus.attach();
@@ -104,10 +110,84 @@ fn configured_over_sdo_applied_and_received() {
     };
     assert_eq!(received.mode, 3);
     assert_eq!(received.status, sdo.read::<od::Statusword>().unwrap());
-    assert_eq!(received.position, sdo.read::<od::PositionActualValue>().unwrap());
+    assert_eq!(
+        received.position,
+        sdo.read::<od::PositionActualValue>().unwrap()
+    );
     assert_eq!(StatusPosition::LEN, 7);
-    assert_eq!(StatusPosition::MAPPING, [0x6041_0010, 0x6064_0020, 0x6060_0008]);
+    assert_eq!(
+        StatusPosition::MAPPING,
+        [0x6041_0010, 0x6064_0020, 0x6060_0008]
+    );
 
     stop.store(true, Ordering::Relaxed);
+    let device = serving.join().unwrap();
+
+    // python-canopen reads the mapping back and decodes a TPDO2.
+    let py = PyPeer::spawn().unwrap_or_else(|e| panic!("{e}"));
+    let mut py_port = py.port();
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let serving = std::thread::spawn(move || {
+        let mut device = device;
+        blocking::serve(&mut py_port, &clock, &mut device, &flag, None, |_| {})
+    });
+    let node = drive.get();
+    py.command_ok(json!({"op": "remote_node_eds", "node": node, "eds": dcf()}))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let maps = py
+        .command_ok(json!({"op": "tpdo_read", "node": node, "timeout": 2.0}))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let tpdo2 = maps["maps"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .find(|m| m["number"] == 2)
+        .unwrap_or_else(|| panic!("python-canopen read no TPDO2: {maps}"));
+    assert_eq!(tpdo2["enabled"], Value::Bool(true), "{tpdo2}");
+    assert_eq!(
+        tpdo2["cob_id"].as_u64(),
+        StatusPosition::default_cob_id(drive).map(u64::from)
+    );
+    let mapped: Vec<u32> = tpdo2["map"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| {
+            (v[0].as_u64().unwrap() << 16 | v[1].as_u64().unwrap() << 8 | v[2].as_u64().unwrap())
+                as u32
+        })
+        .collect();
+    assert_eq!(mapped, StatusPosition::MAPPING);
+    let reply = py
+        .command_ok(json!({"op": "tpdo_wait", "node": node, "number": 2, "timeout": 3.0}))
+        .unwrap_or_else(|e| panic!("{e}"));
+    let data: Vec<u8> = {
+        let text = reply["data"].as_str().unwrap();
+        (0..text.len())
+            .step_by(2)
+            .map(|i| u8::from_str_radix(&text[i..i + 2], 16).unwrap())
+            .collect()
+    };
+    let theirs: Vec<i64> = reply["values"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v[2].as_i64().unwrap())
+        .collect();
+    let p = StatusPosition::decode(&data).unwrap();
+    let ours = vec![
+        i64::from(p.status),
+        i64::from(p.position),
+        i64::from(p.mode),
+    ];
+    assert_eq!(theirs, ours, "data {data:02X?}");
+    stop.store(true, Ordering::Relaxed);
     serving.join().unwrap().unwrap();
+}
+
+/// The vendor DCF the build script generates from.
+fn dcf() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../../shared/eds-corpus/files/elmo_gold-drive_ros-test-utils.dcf")
 }
