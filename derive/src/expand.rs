@@ -81,7 +81,10 @@ pub(crate) fn expand(pdo: &Pdo) -> TokenStream {
             None => quote!(#ident: ()),
         }
     });
-    let encodes = pdo.fields.iter().enumerate().filter_map(|(i, f)| {
+    // The highest field first, as the generator writes it: the compiler
+    // merges adjacent fields from the top of the word into one load more
+    // readily that way.
+    let encodes = pdo.fields.iter().enumerate().rev().filter_map(|(i, f)| {
         let ident = f.ident;
         let i = Literal::usize_unsuffixed(i);
         entry(&f.kind).map(|_| {

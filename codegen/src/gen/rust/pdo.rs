@@ -402,6 +402,9 @@ fn emit_struct(
             word = #rt::pdo::layout::put(word, #offset, #width, #rt::od::Scalar::to_raw(self.#name));
         });
     }
+    // The highest field first: the compiler merges adjacent fields from
+    // the top of the word into one load more readily that way.
+    encodes.reverse();
     let derives = super::derives::attr(super::derives::PDO, float);
     let cob_default = comm_default(1);
     let cob = cob_id_items(cob_default, rt);
