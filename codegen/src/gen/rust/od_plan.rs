@@ -110,20 +110,13 @@ pub(crate) fn plan<'d>(
             let entry = object.entries.values().next().expect("non-empty");
             // A pin (`rust_name:`) wins over the canonical and the source name.
             let pin = entry.rust_name.as_deref().or(object.rust_name.as_deref());
-            let (zst, name) = match (pin, &fixed) {
-                (Some(pin), _) => (
-                    types.request_pinned(pin, &key, Some(&object.origin)),
-                    values::Name::Fixed(pin),
-                ),
-                (None, Some(name)) => (
-                    types.request_fixed(name, &key, Some(&object.origin)),
-                    values::Name::Fixed(name),
-                ),
-                (None, None) => (
-                    types.request(&object.name, &key, Some(&object.origin)),
-                    values::Name::Source(&entry.name),
-                ),
-            };
+            let (zst, name) = request_entry(
+                &mut types,
+                (pin, fixed.as_deref()),
+                (&object.name, &entry.name),
+                &key,
+                &object.origin,
+            );
             let fixed_name = matches!(name, values::Name::Fixed(_));
             let value = values::plan(entry, name, error_plan(device, errors, entry), &mut types);
             root.push(RootPlan {
@@ -164,20 +157,13 @@ pub(crate) fn plan<'d>(
                     let fixed = standard
                         .then(|| canonical.sub(object.index, entry.subindex))
                         .flatten();
-                    let (zst, name) = match (&entry.rust_name, &fixed) {
-                        (Some(pin), _) => (
-                            ns.request_pinned(pin, &key, Some(&entry.origin)),
-                            values::Name::Fixed(pin),
-                        ),
-                        (None, Some(name)) => (
-                            ns.request_fixed(name, &key, Some(&entry.origin)),
-                            values::Name::Fixed(name),
-                        ),
-                        (None, None) => (
-                            ns.request(&entry.name, &key, Some(&entry.origin)),
-                            values::Name::Source(&entry.name),
-                        ),
-                    };
+                    let (zst, name) = request_entry(
+                        &mut ns,
+                        (entry.rust_name.as_deref(), fixed.as_deref()),
+                        (&entry.name, &entry.name),
+                        &key,
+                        &entry.origin,
+                    );
                     let fixed_name = matches!(name, values::Name::Fixed(_));
                     let value =
                         values::plan(entry, name, error_plan(device, errors, entry), &mut ns);
@@ -196,26 +182,26 @@ pub(crate) fn plan<'d>(
                 // source name.
                 let (first_sub, last_sub) = (first.subindex, elements[elements.len() - 1].subindex);
                 let key = format!("subs {first_sub}..{last_sub}");
-                let (zst, name) = match (&object.rust_name, &fixed_names(&canonical, object)) {
-                    (Some(pin), _) => {
-                        let camel = naming::sanitize(pin, Case::UpperCamel);
-                        (ns.request_fixed(&camel, &key, Some(&object.origin)), camel)
-                    }
-                    (None, Some(name)) => (
+                // The module's pin is snake case; the type takes it in
+                // UpperCamelCase, as fixed (a collision with it is the
+                // module pin's, reported there).
+                let camel_pin = object
+                    .rust_name
+                    .as_deref()
+                    .map(|pin| naming::sanitize(pin, Case::UpperCamel));
+                let canonical_name = canonical.object(object.index);
+                let fixed = camel_pin.as_deref().or(canonical_name.as_deref());
+                let (zst, name) = match fixed {
+                    Some(name) => (
                         ns.request_fixed(name, &key, Some(&object.origin)),
-                        name.clone(),
+                        values::Name::Fixed(name),
                     ),
-                    (None, None) => (
+                    None => (
                         ns.request(&object.name, &key, Some(&object.origin)),
-                        object.name.clone(),
+                        values::Name::Source(&object.name),
                     ),
                 };
-                let value = values::plan(
-                    first,
-                    values::Name::Fixed(&name),
-                    error_plan(device, errors, first),
-                    &mut ns,
-                );
+                let value = values::plan(first, name, error_plan(device, errors, first), &mut ns);
                 entries.push(EntryPlan {
                     entry: first,
                     zst,
@@ -243,9 +229,31 @@ pub(crate) fn plan<'d>(
     }
 }
 
-/// The canonical name of a standard object (of the device's profiles).
-fn fixed_names(canonical: &Canonical, object: &Object) -> Option<String> {
-    canonical.object(object.index)
+/// Requests an entry type's name by the one precedence rule: its
+/// `rust_name:` pin, else its canonical name, else its source name
+/// (`sources.0`); returns it with the name its value types are made from
+/// (the pin, the canonical name, or `sources.1`).
+fn request_entry<'a>(
+    ns: &mut Namespace,
+    (pin, canonical): (Option<&'a str>, Option<&'a str>),
+    sources: (&str, &'a str),
+    key: &str,
+    origin: &crate::ir::Origin,
+) -> (NameId, values::Name<'a>) {
+    match (pin, canonical) {
+        (Some(pin), _) => (
+            ns.request_pinned(pin, key, Some(origin)),
+            values::Name::Fixed(pin),
+        ),
+        (None, Some(name)) => (
+            ns.request_fixed(name, key, Some(origin)),
+            values::Name::Fixed(name),
+        ),
+        (None, None) => (
+            ns.request(sources.0, key, Some(origin)),
+            values::Name::Source(sources.1),
+        ),
+    }
 }
 
 /// The elements of an ARRAY (or of a standard object whose subs the
