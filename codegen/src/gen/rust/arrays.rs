@@ -118,9 +118,11 @@ impl<'a> NameForm<'a> {
             return NameForm::Irregular;
         };
         let offset = number - i32::from(elements[0].subindex);
-        let numbered = elements
-            .iter()
-            .all(|e| split(&e.name) == Some((stem, i32::from(e.subindex) + offset)));
+        let numbered = elements.iter().all(|e| {
+            // A number near i32::MAX in a name: no overflow, no pattern.
+            let expected = i32::from(e.subindex).checked_add(offset);
+            expected.is_some_and(|n| split(&e.name) == Some((stem, n)))
+        });
         if numbered {
             NameForm::Numbered { stem, offset }
         } else {
@@ -388,7 +390,41 @@ fn runs(subs: &[u8]) -> Vec<(u8, u8)> {
 
 #[cfg(test)]
 mod tests {
-    use super::runs;
+    use super::{NameForm, runs};
+    use crate::ir::{Access, DataType, Entry};
+
+    fn element(sub: u8, name: &str) -> Entry {
+        let mut e = Entry::highest_subindex(0, Default::default());
+        e.subindex = sub;
+        e.name = name.to_string();
+        e.data_type = DataType::Unsigned32;
+        e.access = Access::Ro;
+        e
+    }
+
+    #[test]
+    fn element_names_are_read_without_overflow() {
+        let numbered = [element(1, "Field 1"), element(2, "Field 2")];
+        let refs: Vec<&Entry> = numbered.iter().collect();
+        assert!(matches!(
+            NameForm::of(&refs),
+            NameForm::Numbered {
+                stem: "Field ",
+                offset: 0
+            }
+        ));
+        // Numbers at the end of i32: irregular, never a panic.
+        let huge = [element(1, "X2147483647"), element(2, "X2147483648")];
+        let refs: Vec<&Entry> = huge.iter().collect();
+        assert!(matches!(NameForm::of(&refs), NameForm::Irregular));
+        let huge = [
+            element(1, "X2147483646"),
+            element(2, "X2147483647"),
+            element(3, "X0"),
+        ];
+        let refs: Vec<&Entry> = huge.iter().collect();
+        assert!(matches!(NameForm::of(&refs), NameForm::Irregular));
+    }
 
     #[test]
     fn consecutive_subs_become_runs() {
