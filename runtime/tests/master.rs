@@ -282,7 +282,16 @@ fn nmt_command_bytes_and_the_state_the_node_reports() {
         rig.master.core().nmt.state(node(DEVICE)),
         Some(NmtState::Operational)
     );
-    assert!(rig.seen(0x720).iter().any(|(_, f)| f.data() == [0x05]));
+    // The monitor records on its own thread: the heartbeat the master has
+    // just seen may reach its log a moment later.
+    let deadline = StdInstant::now() + Duration::from_secs(1);
+    while !rig.seen(0x720).iter().any(|(_, f)| f.data() == [0x05]) {
+        assert!(
+            StdInstant::now() < deadline,
+            "no operational heartbeat 0x720#05 on the bus"
+        );
+        thread::sleep(Duration::from_millis(5));
+    }
 }
 
 #[test]
