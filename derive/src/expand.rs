@@ -130,34 +130,12 @@ pub(crate) fn expand(pdo: &Pdo) -> TokenStream {
     } else {
         TokenStream::new()
     };
-    // The layout in rustdoc, on `LEN` (a derive cannot document the struct
-    // itself): the fields in mapping order with their entries and widths;
-    // the offsets follow from the entries' sizes, which only the compiler
-    // knows (`MAPPING` has them).
-    let mut len_doc = vec![
-        format!(" Data length in bytes of {kind}{}.", pdo.number),
-        String::new(),
-        " | Field | Maps | Bits |".to_string(),
-        " |---|---|---|".to_string(),
-    ];
-    for f in &pdo.fields {
-        let (maps, bits) = match &f.kind {
-            FieldKind::Entry { path, bits } => (
-                format!("`{}`", quote!(#path).to_string().replace(' ', "")),
-                bits.map_or("its data type's size".to_string(), |b| b.to_string()),
-            ),
-            FieldKind::Gap(n) => ("(gap: dummy entries)".to_string(), n.to_string()),
-        };
-        len_doc.push(format!(" | `{}` | {maps} | {bits} |", f.ident));
-    }
-    len_doc.push(String::new());
-    len_doc.push(
-        " Fields follow one another from bit 0 of byte 0 (little endian); `MAPPING` is the mapping parameter's entries."
-            .to_string(),
-    );
+    let layout_doc = crate::layout_doc::lines(pdo);
+    let len_doc = format!(" Data length in bytes of {kind}{}.", pdo.number);
     quote! {
+        #(#[doc = #layout_doc])*
         impl #name {
-            #(#[doc = #len_doc])*
+            #[doc = #len_doc]
             pub const LEN: usize = #rt::pdo::layout::len(#rt::pdo::derive::total(#name::__PDO_WIDTHS));
             #[doc(hidden)]
             const __PDO_WIDTHS: [u32; #n_lit] = [#(#widths),*];
@@ -261,11 +239,26 @@ fn checks(pdo: &Pdo) -> TokenStream {
         out.extend(quote_spanned! {ty_span=>
             #d::value_of::<#path, #ty>();
         });
-        if let Some(bits) = bits {
-            let b = Literal::u32_unsuffixed(*bits);
-            out.extend(quote_spanned! {span=>
-                #d::bits_fit::<#d::Check<{ #b <= #d::type_bits(<#path as #rt::od::Entry>::DATA_TYPE) }>>();
-            });
+        match (bits, crate::layout_doc::natural_bits(ty)) {
+            (Some(bits), _) => {
+                let b = Literal::u32_unsuffixed(*bits);
+                out.extend(quote_spanned! {span=>
+                    #d::bits_fit::<#d::Check<{ #b <= #d::type_bits(<#path as #rt::od::Entry>::DATA_TYPE) }>>();
+                });
+            }
+            // The layout table states the primitive type's width: it must
+            // be the entry's. (When the type is not the entry's value type
+            // at all, `value_of` says so and this check stays quiet.)
+            (None, Some(natural)) => {
+                let n = Literal::u32_unsuffixed(natural);
+                out.extend(quote_spanned! {ty_span=>
+                    #d::width_as_documented::<#d::Check<{
+                        #d::type_bits(<#path as #rt::od::Entry>::DATA_TYPE) == #n
+                            || ::core::mem::size_of::<<#path as #rt::od::Entry>::Value>() * 8 != #n
+                    }>>();
+                });
+            }
+            (None, None) => {}
         }
     }
     out

@@ -26,6 +26,7 @@
 #![forbid(unsafe_code)]
 
 mod expand;
+mod layout_doc;
 mod parse;
 
 use proc_macro::TokenStream;

@@ -406,14 +406,14 @@ fn derived_pdos_are_configured_and_read_back_by_python() {
             StdInstant::now() < deadline,
             "no TPDO4 with statusword {status:?} on the in-process bus; last {last:?}"
         );
-        if let Some(f) = watch.recv(Duration::from_millis(100)).expect("receive") {
-            if f.id() == CanId::Standard(cob) {
-                let p = StatusVelocity::decode(f.data()).expect("TPDO4 length");
-                last = Some(p);
-                if p.status == status {
-                    assert_eq!(p.mode, mode);
-                    break;
-                }
+        if let Some(f) = watch.recv(Duration::from_millis(100)).expect("receive")
+            && f.id() == CanId::Standard(cob)
+        {
+            let p = StatusVelocity::decode(f.data()).expect("TPDO4 length");
+            last = Some(p);
+            if p.status == status {
+                assert_eq!(p.mode, mode);
+                break;
             }
         }
     }

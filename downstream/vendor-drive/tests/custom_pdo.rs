@@ -14,38 +14,20 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant as WallClock};
 
 use eds2rust_runtime::blocking::{self, SdoClient};
-use eds2rust_runtime::od::{Entry, NodeId, Pdo as _};
+use eds2rust_runtime::od::{NodeId, Pdo as _};
 use eds2rust_runtime::pdo::PdoConfig;
 use eds2rust_runtime::pdo::blocking::configure_pdo;
 use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::client::ClientConfig;
 use eds2rust_runtime::transport::virtual_bus::VirtualBus;
 use eds2rust_runtime::transport::{Bus, Clock};
-use eds2rust_runtime::{CanId, Frame, Pdo};
+use eds2rust_runtime::{CanId, Frame};
 use eds2rust_sim::{Device, DeviceConfig};
 use eds2rust_tests::peer::PyPeer;
 use serde_json::{Value, json};
 use vendor_drive::drive::od;
 
-#[derive(Pdo, Debug, Clone, Copy, PartialEq)]
-#[pdo(tpdo = 2)]
-pub struct StatusPosition {
-    #[pdo(entry = od::Statusword)]
-    pub status: <od::Statusword as Entry>::Value,
-    #[pdo(entry = od::PositionActualValue)]
-    pub position: <od::PositionActualValue as Entry>::Value,
-    #[pdo(entry = od::ModesOfOperation)]
-    pub mode: <od::ModesOfOperation as Entry>::Value,
-}
-
-#[derive(Pdo, Debug, Clone, Copy, PartialEq)]
-#[pdo(rpdo = 1)]
-pub struct ControlVelocity {
-    #[pdo(entry = od::Controlword)]
-    pub control: <od::Controlword as Entry>::Value,
-    #[pdo(entry = od::TargetVelocity)]
-    pub velocity: <od::TargetVelocity as Entry>::Value,
-}
+use vendor_drive::mapping::{ControlVelocity, StatusPosition};
 
 #[test]
 fn configured_over_sdo_applied_and_received() {

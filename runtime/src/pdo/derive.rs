@@ -44,17 +44,30 @@ impl MappedOnce for Check<true> {}
 pub trait FixedSize {}
 impl FixedSize for Check<true> {}
 
-/// The field's type is the value type of its entry.
+/// The field's type is `V`, the value type of the entry `E` it maps.
 #[diagnostic::on_unimplemented(
-    message = "the field's type `{Self}` is not the value type of `{E}`",
-    label = "not `<{E} as Entry>::Value`",
-    note = "give the field the entry's value type: `<{E} as Entry>::Value` or the type it names"
+    message = "the field's type `{Self}` is not `{V}`, the value type of `{E}`",
+    label = "expected `{V}`",
+    note = "give the field the entry's value type: `{V}` (or write `<{E} as Entry>::Value`)"
 )]
-pub trait ValueOf<E> {}
-impl<E: Entry> ValueOf<E> for E::Value {}
+pub trait ValueTypeOf<E, V> {}
+impl<E, V> ValueTypeOf<E, V> for V {}
 
 /// Compiles only when `T` is `E`'s value type.
-pub const fn value_of<E: Entry, T: ValueOf<E>>() {}
+pub const fn value_of<E: Entry, T: ValueTypeOf<E, E::Value>>() {}
+
+/// The width the struct's layout table states for a field (its Rust type's
+/// size) is the mapped one.
+#[diagnostic::on_unimplemented(
+    message = "this entry is narrower than the field's type: write its width with `bits = N`",
+    label = "the entry maps fewer bits than this type holds",
+    note = "an INTEGER24 in an `i32` (or a 40-, 48- or 56-bit type in a 64-bit one) is mapped with `bits = 24` (40, 48, 56), so that the layout the struct documents is the one on the bus"
+)]
+pub trait WidthAsDocumented {}
+impl WidthAsDocumented for Check<true> {}
+
+/// Compiles only when the check holds.
+pub const fn width_as_documented<C: WidthAsDocumented>() {}
 
 /// Compiles only when the check holds.
 pub const fn fits<C: FitsInPdo>() {}
