@@ -10,6 +10,7 @@
 use core::fmt;
 use core::ops::ControlFlow;
 use core::time::Duration;
+use std::collections::VecDeque;
 use std::io;
 use std::string::String;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -17,6 +18,7 @@ use std::vec::Vec;
 
 use crate::od::{self, Entry};
 use crate::sdo::client::{self, ClientConfig, ClientEvent, Method};
+use crate::sdo::typed::{self, LengthNote};
 use crate::sdo::{AbortCode, SdoError};
 pub use crate::time::Deadline;
 use crate::transport::{Bus, Clock};
@@ -271,21 +273,33 @@ impl Transfer<'_> {
     }
 }
 
+/// The data a transfer ended with (empty for downloads), and whether it
+/// is an expedited response's padded 4 bytes
+/// ([`ClientEvent::Uploaded`]'s `padded`).
+pub(crate) struct Upload {
+    pub(crate) data: Vec<u8>,
+    pub(crate) padded: bool,
+}
+
 /// The value `drive`'s closure breaks with once the transfer of (index,
 /// sub) ended: the uploaded data (empty for downloads) or the error.
 pub(crate) fn transfer_end(
     event: ClientEvent,
     index: u16,
     sub: u8,
-) -> ControlFlow<Result<Vec<u8>, Error>> {
+) -> ControlFlow<Result<Upload, Error>> {
     match event {
         ClientEvent::Uploaded {
             index: i,
             sub: s,
             data,
-        } if (i, s) == (index, sub) => ControlFlow::Break(Ok(data)),
+            padded,
+        } if (i, s) == (index, sub) => ControlFlow::Break(Ok(Upload { data, padded })),
         ClientEvent::Downloaded { index: i, sub: s } if (i, s) == (index, sub) => {
-            ControlFlow::Break(Ok(Vec::new()))
+            ControlFlow::Break(Ok(Upload {
+                data: Vec::new(),
+                padded: false,
+            }))
         }
         ClientEvent::Failed {
             index: i,
@@ -353,6 +367,7 @@ pub struct SdoClient<B> {
     bus: B,
     clock: Clock,
     core: client::SdoClient,
+    notes: VecDeque<LengthNote>,
 }
 
 impl<B: Bus> SdoClient<B> {
@@ -367,7 +382,16 @@ impl<B: Bus> SdoClient<B> {
             bus,
             clock,
             core: client::SdoClient::new(config),
+            notes: VecDeque::new(),
         }
+    }
+
+    /// The notes typed reads left since the last call (at most
+    /// [`typed::NOTES_KEPT`], the newest): values the server sent longer
+    /// than their data type, of which the leading bytes were taken. Empty
+    /// with [`ClientConfig::strict_lengths`], which refuses them instead.
+    pub fn take_length_notes(&mut self) -> Vec<LengthNote> {
+        self.notes.drain(..).collect()
     }
 
     /// The sans-IO core.
@@ -390,7 +414,7 @@ impl<B: Bus> SdoClient<B> {
         self.bus
     }
 
-    fn transfer(&mut self, index: u16, sub: u8, transfer: Transfer<'_>) -> Result<Vec<u8>, Error> {
+    fn transfer(&mut self, index: u16, sub: u8, transfer: Transfer<'_>) -> Result<Upload, Error> {
         let now = self.clock.now();
         transfer.start(&mut self.core, now, index, sub)?;
         let deadline = now + transfer.bound(self.core.config());
@@ -416,6 +440,7 @@ impl<B: Bus> SdoClient<B> {
     /// Reads (index, sub) with `method`.
     pub fn upload_with(&mut self, index: u16, sub: u8, method: Method) -> Result<Vec<u8>, Error> {
         self.transfer(index, sub, Transfer::Upload(method))
+            .map(|upload| upload.data)
     }
 
     /// Writes `data` to (index, sub) with [`Method::Auto`].
@@ -536,8 +561,13 @@ impl<B: Bus> SdoClient<B> {
         E::Access: od::Read,
         E::Value: od::Scalar,
     {
-        let data = self.upload(E::INDEX, sub)?;
-        Ok(od::decode_value::<E>(&data)?)
+        let upload = self.transfer(E::INDEX, sub, Transfer::Upload(Method::Auto))?;
+        let strict = self.core.config().strict_lengths;
+        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)?;
+        if let Some(note) = note {
+            typed::keep(&mut self.notes, note);
+        }
+        Ok(value)
     }
 
     /// Typed write of sub `sub` of `E`'s object.

@@ -10,13 +10,15 @@
 use core::future::Future;
 use core::ops::ControlFlow;
 use core::pin::pin;
+use std::collections::VecDeque;
 use std::string::String;
 use std::vec::Vec;
 
 pub use crate::blocking::{DriveError, Error};
-use crate::blocking::{Transfer, encode, give_up, transfer_end, visible_string};
+use crate::blocking::{Transfer, Upload, encode, give_up, transfer_end, visible_string};
 use crate::od::{self, Entry};
 use crate::sdo::client::{self, ClientConfig, Method};
+use crate::sdo::typed::{self, LengthNote};
 pub use crate::time::Deadline;
 use crate::transport::{AsyncBus, Clock};
 use crate::{Instant, Service};
@@ -156,6 +158,7 @@ pub struct SdoClient<B> {
     bus: B,
     clock: Clock,
     core: client::SdoClient,
+    notes: VecDeque<LengthNote>,
 }
 
 impl<B: AsyncBus> SdoClient<B> {
@@ -170,7 +173,14 @@ impl<B: AsyncBus> SdoClient<B> {
             bus,
             clock,
             core: client::SdoClient::new(config),
+            notes: VecDeque::new(),
         }
+    }
+
+    /// The notes typed reads left since the last call (see
+    /// [`crate::blocking::SdoClient::take_length_notes`]).
+    pub fn take_length_notes(&mut self) -> Vec<LengthNote> {
+        self.notes.drain(..).collect()
     }
 
     /// The sans-IO core.
@@ -198,7 +208,7 @@ impl<B: AsyncBus> SdoClient<B> {
         index: u16,
         sub: u8,
         transfer: Transfer<'_>,
-    ) -> Result<Vec<u8>, Error> {
+    ) -> Result<Upload, Error> {
         let start = now(&self.clock);
         transfer.start(&mut self.core, start, index, sub)?;
         let deadline = start + transfer.bound(self.core.config());
@@ -228,7 +238,9 @@ impl<B: AsyncBus> SdoClient<B> {
         sub: u8,
         method: Method,
     ) -> Result<Vec<u8>, Error> {
-        self.transfer(index, sub, Transfer::Upload(method)).await
+        self.transfer(index, sub, Transfer::Upload(method))
+            .await
+            .map(|upload| upload.data)
     }
 
     /// Writes `data` to (index, sub) with [`Method::Auto`].
@@ -256,8 +268,16 @@ impl<B: AsyncBus> SdoClient<B> {
         E::Access: od::Read,
         E::Value: od::Scalar,
     {
-        let data = self.upload(E::INDEX, E::SUBINDEX).await?;
-        Ok(od::decode_value::<E>(&data)?)
+        let sub = E::SUBINDEX;
+        let upload = self
+            .transfer(E::INDEX, sub, Transfer::Upload(Method::Auto))
+            .await?;
+        let strict = self.core.config().strict_lengths;
+        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)?;
+        if let Some(note) = note {
+            typed::keep(&mut self.notes, note);
+        }
+        Ok(value)
     }
 
     /// Writes `value` to entry `E`.

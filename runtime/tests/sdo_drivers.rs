@@ -8,6 +8,7 @@ use std::time::Duration;
 use eds2rust_runtime::blocking::{self, Error};
 use eds2rust_runtime::od::{DataType, Entry, ValueError, access, bytes};
 use eds2rust_runtime::sdo::client::ClientConfig;
+use eds2rust_runtime::sdo::typed::LengthNote;
 use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use eds2rust_runtime::{CanId, Frame};
@@ -41,6 +42,9 @@ entry!(Counter, 0x2001, 0, Unsigned16, Ro, u16);
 entry!(BadName, 0x2002, 0, VisibleString, Ro, bytes::VisibleString);
 entry!(Label, 0x2004, 0, VisibleString, Rw, bytes::VisibleString);
 entry!(Silent, 0x2FFF, 0, Unsigned32, Rw, u32);
+entry!(Mode, 0x2003, 0, Integer8, Ro, i8);
+entry!(Level, 0x2005, 0, Unsigned8, Ro, u8);
+entry!(Wide, 0x2006, 0, Unsigned24, Ro, u32);
 
 /// Node 5: requests on 0x605, answers on 0x585.
 const REQUEST: u16 = 0x605;
@@ -85,6 +89,16 @@ impl FakeNode {
             [0x40, 0x00, 0x20, 0x01, ..] => [0x4B, 0x00, 0x20, 0x01, 0x38, 0xFF, 0, 0],
             // Upload 0x2001:00: 4 bytes (0x43) for a 2-byte entry.
             [0x40, 0x01, 0x20, 0x00, ..] => [0x43, 0x01, 0x20, 0x00, 1, 2, 3, 4],
+            // Upload 0x2003:00: expedited without size (0x42), 4 bytes of
+            // which an INTEGER8 is the first.
+            [0x40, 0x03, 0x20, 0x00, ..] => [0x42, 0x03, 0x20, 0x00, 0xFD, 0xAA, 0xBB, 0xCC],
+            // Upload 0x2005:00: one data byte (0x4F) in a 5-byte frame.
+            [0x40, 0x05, 0x20, 0x00, ..] => {
+                let frame = [0x4F, 0x05, 0x20, 0x00, 0x07];
+                return Some(Frame::new(CanId::Standard(RESPONSE), &frame).unwrap());
+            }
+            // Upload 0x2006:00: UNSIGNED24 without size (0x42).
+            [0x40, 0x06, 0x20, 0x00, ..] => [0x42, 0x06, 0x20, 0x00, 0x01, 0x02, 0x03, 0x99],
             // Upload 0x2002:00: "ca" then 0xE9 (0x47).
             [0x40, 0x02, 0x20, 0x00, ..] => [0x47, 0x02, 0x20, 0x00, b'c', b'a', 0xE9, 0],
             // Download 0x2004:00, 3 bytes (0x27): confirm.
@@ -140,13 +154,21 @@ fn blocking_typed_access() {
     client.write_bytes::<Label>(b"abc").unwrap();
     assert_eq!(client.upload(0x1017, 0).unwrap(), [0xFA, 0x00]);
 
-    assert!(matches!(
-        client.read::<Counter>(),
-        Err(Error::Value(ValueError::Length {
-            expected: 2,
-            actual: 4
-        }))
-    ));
+    // 4 bytes announced for a 2-byte entry: the leading two, and a note.
+    assert_eq!(client.read::<Counter>().unwrap(), 0x0201);
+    let note = LengthNote {
+        index: 0x2001,
+        sub: 0,
+        data_type: DataType::Unsigned16,
+        received: 4,
+    };
+    assert_eq!(client.take_length_notes(), [note]);
+    // No size indicated: the leading bytes, nothing to note.
+    assert_eq!(client.read::<Mode>().unwrap(), -3);
+    assert_eq!(client.read::<Wide>().unwrap(), 0x03_0201);
+    // A 5-byte response.
+    assert_eq!(client.read::<Level>().unwrap(), 7);
+    assert!(client.take_length_notes().is_empty());
     assert!(matches!(
         client.read_string::<BadName>(),
         Err(Error::NotVisible {
@@ -170,6 +192,27 @@ fn blocking_typed_access() {
         node.requests[6],
         [0x27, 0x04, 0x20, 0x00, b'a', b'b', b'c', 0]
     );
+}
+
+#[test]
+fn blocking_strict_lengths_refuse_a_longer_value() {
+    let bus = VirtualBus::new();
+    let (stop, node) = spawn_node(bus.attach(), 1000);
+    let mut strict = config(Duration::from_millis(200));
+    strict.strict_lengths = true;
+    let mut client = blocking::SdoClient::new(bus.attach(), strict);
+    assert!(matches!(
+        client.read::<Counter>(),
+        Err(Error::Value(ValueError::Length {
+            expected: 2,
+            actual: 4
+        }))
+    ));
+    // Padding of a response without size is no excess.
+    assert_eq!(client.read::<Mode>().unwrap(), -3);
+    assert!(client.take_length_notes().is_empty());
+    stop.store(true, Ordering::Relaxed);
+    node.join().unwrap();
 }
 
 #[test]
@@ -241,13 +284,10 @@ mod tokio_drivers {
         assert_eq!(client.read_string::<DeviceName>().await.unwrap(), "Fan");
         assert_eq!(client.read_bytes::<DeviceName>().await.unwrap(), b"Fan");
         client.write_bytes::<Label>(b"abc").await.unwrap();
-        assert!(matches!(
-            client.read::<Counter>().await,
-            Err(Error::Value(ValueError::Length {
-                expected: 2,
-                actual: 4
-            }))
-        ));
+        assert_eq!(client.read::<Counter>().await.unwrap(), 0x0201);
+        assert_eq!(client.take_length_notes().len(), 1);
+        assert_eq!(client.read::<Mode>().await.unwrap(), -3);
+        assert!(client.take_length_notes().is_empty());
         assert!(matches!(
             client.upload(0x3000, 1).await,
             Err(Error::Sdo(SdoError::RemoteAbort(

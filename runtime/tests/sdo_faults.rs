@@ -188,6 +188,7 @@ fn run(s: &Scenario) -> Result<Outcome, String> {
                     index: i,
                     sub: u,
                     data,
+                    ..
                 } => {
                     if !s.upload || (i, u) != (index, sub) {
                         return Err(format!("unexpected upload of {i:#x}:{u}"));

@@ -13,7 +13,7 @@ mod lss;
 pub use lss::LssRequestError;
 
 use super::{
-    DriveError, Error, IDLE_WAIT, Transfer, encode, give_up, transfer_end, visible_string,
+    DriveError, Error, IDLE_WAIT, Transfer, Upload, encode, give_up, transfer_end, visible_string,
 };
 use crate::master::{self, MasterEvent};
 use crate::nmt::NmtCommand;
@@ -21,6 +21,7 @@ use crate::od::{self, Entry, NodeId};
 use crate::pdo::PdoConfig;
 use crate::pdo::blocking::{PdoConfigError, SdoAccess, run_steps};
 use crate::sdo::client::Method;
+use crate::sdo::typed::{self, LengthNote};
 use crate::time::Deadline;
 use crate::transport::{Bus, Clock};
 use crate::{Instant, Service};
@@ -69,6 +70,7 @@ pub struct Master<B> {
     queue: VecDeque<MasterEvent>,
     capacity: usize,
     dropped: u64,
+    notes: VecDeque<(NodeId, LengthNote)>,
 }
 
 impl<B: Bus> Master<B> {
@@ -86,6 +88,7 @@ impl<B: Bus> Master<B> {
             queue: VecDeque::new(),
             capacity: MASTER_QUEUE_CAPACITY,
             dropped: 0,
+            notes: VecDeque::new(),
         }
     }
 
@@ -241,6 +244,16 @@ impl<B: Bus> Master<B> {
         self.dropped
     }
 
+    /// The notes typed reads left since the last call (at most
+    /// [`typed::NOTES_KEPT`], the newest), with the node: values a server
+    /// sent longer than their data type, of which the leading bytes were
+    /// taken. Empty for nodes whose client has
+    /// [`strict_lengths`](crate::sdo::client::ClientConfig::strict_lengths),
+    /// which refuses them instead.
+    pub fn take_length_notes(&mut self) -> Vec<(NodeId, LengthNote)> {
+        self.notes.drain(..).collect()
+    }
+
     fn push(&mut self, event: MasterEvent) {
         if self.queue.len() >= self.capacity {
             self.dropped = self.dropped.saturating_add(1);
@@ -316,7 +329,7 @@ impl<B: Bus> Master<B> {
         index: u16,
         sub: u8,
         transfer: Transfer<'_>,
-    ) -> Result<Vec<u8>, Error> {
+    ) -> Result<Upload, Error> {
         // Events of transfers started on the core stay queued.
         self.pump();
         let now = self.now();
@@ -356,6 +369,7 @@ impl<B: Bus> Master<B> {
         method: Method,
     ) -> Result<Vec<u8>, Error> {
         self.transfer(node, index, sub, Transfer::Upload(method))
+            .map(|upload| upload.data)
     }
 
     /// Writes `data` to (index, sub) of `node` with [`Method::Auto`].
@@ -491,8 +505,13 @@ impl<B: Bus> Master<B> {
         E::Access: od::Read,
         E::Value: od::Scalar,
     {
-        let data = self.upload(node, E::INDEX, sub)?;
-        Ok(od::decode_value::<E>(&data)?)
+        let upload = self.transfer(node, E::INDEX, sub, Transfer::Upload(Method::Auto))?;
+        let strict = self.core.sdo_or_default(node).config().strict_lengths;
+        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)?;
+        if let Some(note) = note {
+            typed::keep(&mut self.notes, (node, note));
+        }
+        Ok(value)
     }
 
     /// Typed write of sub `sub` of `E`'s object.

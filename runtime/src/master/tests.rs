@@ -173,7 +173,8 @@ fn every_core_sees_every_frame() {
                 ClientEvent::Uploaded {
                     index: 0x1017,
                     sub: 0,
-                    data: vec![0xE8, 0x03]
+                    data: vec![0xE8, 0x03],
+                    padded: false
                 }
             ),
         ]

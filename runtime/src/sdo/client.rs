@@ -92,6 +92,11 @@ pub struct ClientConfig {
     pub block_download_above: Option<usize>,
     /// Use block upload with [`Method::Auto`].
     pub block_upload: bool,
+    /// Typed reads refuse a value longer than the entry's data type (a
+    /// device answering 4 bytes for an UNSIGNED8) with a length error,
+    /// instead of taking its leading bytes and leaving a
+    /// [`LengthNote`](super::typed::LengthNote).
+    pub strict_lengths: bool,
 }
 
 impl ClientConfig {
@@ -106,6 +111,7 @@ impl ClientConfig {
             max_upload: 1 << 20,
             block_download_above: None,
             block_upload: false,
+            strict_lengths: false,
         }
     }
 }
@@ -119,7 +125,16 @@ pub struct Busy;
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum ClientEvent {
     /// An upload succeeded with this value.
-    Uploaded { index: u16, sub: u8, data: Vec<u8> },
+    Uploaded {
+        index: u16,
+        sub: u8,
+        data: Vec<u8>,
+        /// `data` is the 4 bytes of an expedited response that indicated no
+        /// size (command 0x42): the value may be shorter, and the bytes
+        /// after it padding. False for every other upload, whose data is
+        /// the value's exact length.
+        padded: bool,
+    },
     /// A download succeeded.
     Downloaded { index: u16, sub: u8 },
     /// A transfer ended without success.
@@ -198,6 +213,9 @@ pub struct SdoClient {
     /// Download data, or upload data received so far. Its capacity stays
     /// within `max_upload` between transfers.
     buf: Vec<u8>,
+    /// The upload being finished came in an expedited response without
+    /// size indication.
+    padded: bool,
     /// Frames built and not yet taken by `poll_transmit`; a caller that
     /// drains after every input never has more than two waiting. When full
     /// (the caller stopped draining) the oldest is dropped.
@@ -215,6 +233,7 @@ impl SdoClient {
             sub: 0,
             deadline: Instant::ZERO,
             buf: Vec::new(),
+            padded: false,
             tx: Ring::new(),
             events: VecDeque::new(),
         }
@@ -322,7 +341,7 @@ impl SdoClient {
                 sub,
                 data: Initiate::Expedited {
                     data: bytes,
-                    len: size as u8,
+                    len: Some(size as u8),
                 },
             });
             self.wait(now, Phase::ExpeditedDownload { len: size as u8 });
@@ -376,6 +395,7 @@ impl SdoClient {
         self.index = index;
         self.sub = sub;
         self.buf.clear();
+        self.padded = false;
         Ok(())
     }
 
@@ -434,6 +454,7 @@ impl SdoClient {
             index: self.index,
             sub: self.sub,
             data,
+            padded: self.padded,
         })
     }
 
@@ -559,7 +580,21 @@ impl Service for SdoClient {
         match Response::parse(data) {
             Ok(response) => self.on_response(now, response),
             Err(error) => {
-                self.fail(error.abort_code());
+                // Abort as for any invalid command, and report the frame.
+                let code = error.abort_code();
+                self.send(Request::Abort {
+                    index: self.index,
+                    sub: self.sub,
+                    code,
+                });
+                let mut frame = [0u8; 8];
+                let len = data.len().min(8);
+                frame[..len].copy_from_slice(&data[..len]);
+                self.finish_failed(SdoError::BadResponse {
+                    frame,
+                    len: len as u8,
+                    error,
+                });
             }
         }
     }

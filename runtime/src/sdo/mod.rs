@@ -5,6 +5,7 @@
 
 pub mod abort;
 pub mod proto;
+pub mod typed;
 
 #[cfg(feature = "alloc")]
 pub mod client;
@@ -30,6 +31,14 @@ pub enum SdoError {
     /// The peer did not answer within the timeout; this side sent abort
     /// 0x05040000.
     Timeout,
+    /// The server sent a frame that is no valid SDO response (an unknown
+    /// command, or shorter than its command needs); this side sent abort
+    /// 0x05040001. `frame[..len]` is the frame's data.
+    BadResponse {
+        frame: [u8; 8],
+        len: u8,
+        error: proto::ParseError,
+    },
 }
 
 impl SdoError {
@@ -38,6 +47,7 @@ impl SdoError {
         match self {
             SdoError::RemoteAbort(c) | SdoError::LocalAbort(c) => c,
             SdoError::Timeout => AbortCode::Timeout,
+            SdoError::BadResponse { error, .. } => error.abort_code(),
         }
     }
 }
@@ -48,6 +58,14 @@ impl fmt::Display for SdoError {
             SdoError::RemoteAbort(c) => write!(f, "the SDO peer aborted the transfer: {c}"),
             SdoError::LocalAbort(c) => write!(f, "aborted the SDO transfer: {c}"),
             SdoError::Timeout => f.write_str("the SDO peer did not answer in time"),
+            SdoError::BadResponse { frame, len, error } => {
+                f.write_str("the SDO server sent an invalid response [")?;
+                for (i, b) in frame.iter().take(usize::from(*len)).enumerate() {
+                    let sep = if i == 0 { "" } else { " " };
+                    write!(f, "{sep}{b:02X}")?;
+                }
+                write!(f, "]: {error}; aborted with {}", error.abort_code())
+            }
         }
     }
 }

@@ -14,9 +14,10 @@ use super::AbortCode;
 /// Data of an initiate request or response.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Initiate {
-    /// Expedited: up to 4 bytes in the frame. `len` is 4 when the sender did
-    /// not indicate the size.
-    Expedited { data: [u8; 4], len: u8 },
+    /// Expedited: up to 4 bytes in the frame. `len` is the size the sender
+    /// indicated (1 to 4); `None` when it did not (command `0x42`/`0x22`):
+    /// the frame's 4 bytes are then all data, and the value may be shorter.
+    Expedited { data: [u8; 4], len: Option<u8> },
     /// Segmented: the data follows in segments; the total size when indicated.
     Segmented { size: Option<u32> },
 }
@@ -138,6 +139,10 @@ pub struct BlockSegment {
 pub enum ParseError {
     /// Not 8 data bytes (or a remote frame).
     Length(usize),
+    /// A response of `len` data bytes whose command needs `needed` (CiA 301
+    /// frames have 8; a response may leave out trailing bytes it does not
+    /// use, but not these).
+    Short { len: usize, needed: usize },
     /// An unknown command specifier or sub-command.
     Command(u8),
     /// A field out of range (a segment length, a sequence number of 0 or 128+).
@@ -155,6 +160,10 @@ impl fmt::Display for ParseError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             ParseError::Length(n) => write!(f, "SDO frame has {n} data bytes, not 8"),
+            ParseError::Short { len, needed } => write!(
+                f,
+                "SDO response has {len} data bytes; its command needs at least {needed}"
+            ),
             ParseError::Command(b) => write!(f, "unknown SDO command byte {b:#04x}"),
             ParseError::Field(b) => write!(f, "SDO command byte {b:#04x} has a field out of range"),
         }
@@ -188,7 +197,7 @@ fn parse_initiate(d: &[u8; 8]) -> Initiate {
     let b = d[0];
     let (expedited, sized) = (bit(b, 1), bit(b, 0));
     if expedited {
-        let len = if sized { 4 - (b >> 2 & 3) } else { 4 };
+        let len = sized.then(|| 4 - (b >> 2 & 3));
         Initiate::Expedited {
             data: [d[4], d[5], d[6], d[7]],
             len,
@@ -202,7 +211,14 @@ fn parse_initiate(d: &[u8; 8]) -> Initiate {
 
 fn put_initiate(d: &mut [u8; 8], data: &Initiate) {
     match *data {
-        Initiate::Expedited { data, len } => {
+        Initiate::Expedited { data, len: None } => {
+            d[0] |= 0b10;
+            d[4..8].copy_from_slice(&data);
+        }
+        Initiate::Expedited {
+            data,
+            len: Some(len),
+        } => {
             let len = len.clamp(1, 4);
             d[0] |= (4 - len) << 2 | 0b11;
             d[4..8].copy_from_slice(&data);
@@ -369,9 +385,59 @@ impl Request {
     }
 }
 
+/// The data bytes a response with command byte `b` uses: real devices
+/// send shorter frames (a 5-byte expedited response for one data byte),
+/// and the bytes after these carry nothing. An unknown command needs its
+/// first byte only (it fails to parse anyway).
+pub const fn response_len(b: u8) -> usize {
+    let n = (b >> 2 & 3) as usize; // unused bytes of an expedited response
+    match b >> 5 {
+        // Upload segment: the command, then 7 - n data bytes.
+        0 => 8 - (b >> 1 & 7) as usize,
+        1 => 1,
+        2 => match b & 3 {
+            0b11 => 8 - n,
+            0b00 => 4,
+            _ => 8, // expedited without size: all 4 bytes; or the size
+        },
+        3 => 4,
+        4 => 8,
+        5 => match b & 3 {
+            0 => 5,
+            1 => 1,
+            2 => 3,
+            _ => 1,
+        },
+        6 => match b & 3 {
+            0b00 => 4,
+            0b10 => 8,
+            _ => 3,
+        },
+        _ => 1,
+    }
+}
+
 impl Response {
+    /// Parses a response of up to 8 data bytes. A shorter frame is taken
+    /// when it holds every byte its command uses ([`response_len`]); the
+    /// missing trailing bytes read as 0.
     pub fn parse(data: &[u8]) -> Result<Response, ParseError> {
-        let d = eight(data)?;
+        let Some(&b) = data.first() else {
+            return Err(ParseError::Short { len: 0, needed: 1 });
+        };
+        let needed = response_len(b);
+        if data.len() > 8 {
+            return Err(ParseError::Length(data.len()));
+        }
+        if data.len() < needed {
+            return Err(ParseError::Short {
+                len: data.len(),
+                needed,
+            });
+        }
+        let mut padded = [0u8; 8];
+        padded[..data.len()].copy_from_slice(data);
+        let d = &padded;
         let b = d[0];
         let (index, sub) = address(d);
         Ok(match b >> 5 {
@@ -530,99 +596,4 @@ impl BlockSegment {
 pub const CRC: crc::Crc<u16> = crc::Crc::<u16>::new(&crc::CRC_16_XMODEM);
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn expedited_download_of_two_bytes() {
-        // Written from CiA 301: ccs=1, n=2, e=1, s=1 -> 0x2B.
-        let r = Request::DownloadInitiate {
-            index: 0x1017,
-            sub: 0,
-            data: Initiate::Expedited {
-                data: [0xE8, 0x03, 0, 0],
-                len: 2,
-            },
-        };
-        assert_eq!(r.encode(), [0x2B, 0x17, 0x10, 0x00, 0xE8, 0x03, 0, 0]);
-        assert_eq!(Request::parse(&r.encode()), Ok(r));
-    }
-
-    #[test]
-    fn known_command_bytes() {
-        assert_eq!(
-            Request::UploadInitiate {
-                index: 0x1000,
-                sub: 0
-            }
-            .encode()[0],
-            0x40
-        );
-        assert_eq!(
-            Response::DownloadInitiate { index: 1, sub: 0 }.encode()[0],
-            0x60
-        );
-        // Expedited upload response of 4 bytes: 0x43.
-        let r = Response::UploadInitiate {
-            index: 0x1000,
-            sub: 0,
-            data: Initiate::Expedited {
-                data: [0x92, 0x01, 0x02, 0x00],
-                len: 4,
-            },
-        };
-        assert_eq!(r.encode(), [0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00]);
-        // Segmented upload response with size: 0x41.
-        let r = Response::UploadInitiate {
-            index: 0x1008,
-            sub: 0,
-            data: Initiate::Segmented { size: Some(10) },
-        };
-        assert_eq!(r.encode(), [0x41, 0x08, 0x10, 0x00, 10, 0, 0, 0]);
-        // Last upload segment with 3 bytes, toggle 1: 0x1 << 4 | (7-3) << 1 | 1 = 0x19.
-        let r = Response::UploadSegment {
-            toggle: true,
-            last: true,
-            data: [1, 2, 3, 0, 0, 0, 0],
-            len: 3,
-        };
-        assert_eq!(r.encode(), [0x19, 1, 2, 3, 0, 0, 0, 0]);
-        assert_eq!(Request::BlockUploadStart.encode()[0], 0xA3);
-        let r = Request::BlockDownloadInitiate {
-            index: 0x1F50,
-            sub: 1,
-            crc: true,
-            size: Some(0x100),
-        };
-        assert_eq!(r.encode(), [0xC6, 0x50, 0x1F, 0x01, 0x00, 0x01, 0x00, 0x00]);
-        let a = Request::Abort {
-            index: 0x2000,
-            sub: 1,
-            code: AbortCode::WriteReadOnly,
-        };
-        assert_eq!(a.encode(), [0x80, 0x00, 0x20, 0x01, 0x02, 0x00, 0x01, 0x06]);
-    }
-
-    #[test]
-    fn crc_matches_the_ccitt_check_value() {
-        // The CRC catalogue's check value of CRC-16/XMODEM over "123456789".
-        assert_eq!(CRC.checksum(b"123456789"), 0x31C3);
-    }
-
-    #[test]
-    fn wrong_length_and_unknown_commands_are_errors() {
-        assert_eq!(Request::parse(&[0x40, 0, 0]), Err(ParseError::Length(3)));
-        assert_eq!(
-            Request::parse(&[0xE0, 0, 0, 0, 0, 0, 0, 0]),
-            Err(ParseError::Command(0xE0))
-        );
-        assert_eq!(
-            Response::parse(&[0xA3, 0, 0, 0, 0, 0, 0, 0]),
-            Err(ParseError::Command(0xA3))
-        );
-        assert_eq!(
-            BlockSegment::parse(&[0x80, 0, 0, 0, 0, 0, 0, 0]),
-            Err(ParseError::Field(0x80))
-        );
-    }
-}
+mod tests;

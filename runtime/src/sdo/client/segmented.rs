@@ -77,8 +77,9 @@ impl SdoClient {
         }
         match data {
             Initiate::Expedited { data, len } => {
-                let bytes = data.get(..usize::from(len)).unwrap_or(&data);
+                let bytes = data.get(..usize::from(len.unwrap_or(4))).unwrap_or(&data);
                 self.append_upload(bytes, None)?;
+                self.padded = len.is_none();
                 Err(self.finish_upload())
             }
             Initiate::Segmented { size } => {

@@ -3,9 +3,11 @@
 
 mod block;
 mod random;
+mod real_devices;
 
 use super::*;
 use crate::frame::CanId;
+use crate::sdo::proto::ParseError;
 
 const REQUEST: u16 = 0x601;
 const RESPONSE: u16 = 0x581;
@@ -116,7 +118,8 @@ fn expedited_uploads_with_and_without_size() {
         vec![ClientEvent::Uploaded {
             index: 0x1000,
             sub: 0,
-            data: vec![0x92, 0x01, 0x02, 0x00]
+            data: vec![0x92, 0x01, 0x02, 0x00],
+            padded: false
         }]
     );
     // e=1, s=1, n=3: one byte.
@@ -132,7 +135,8 @@ fn expedited_uploads_with_and_without_size() {
         vec![ClientEvent::Uploaded {
             index: 0x1001,
             sub: 0,
-            data: vec![0x05]
+            data: vec![0x05],
+            padded: false
         }]
     );
     // e=1, s=0: size not indicated, all four bytes are taken.
@@ -144,7 +148,8 @@ fn expedited_uploads_with_and_without_size() {
         vec![ClientEvent::Uploaded {
             index: 0x2000,
             sub: 1,
-            data: vec![1, 2, 3, 4]
+            data: vec![1, 2, 3, 4],
+            padded: true
         }]
     );
 }
@@ -180,7 +185,8 @@ fn segmented_upload_of_hello_world() {
         vec![ClientEvent::Uploaded {
             index: 0x1008,
             sub: 0,
-            data: b"Hello, world".to_vec()
+            data: b"Hello, world".to_vec(),
+            padded: false
         }]
     );
     assert!(c.is_idle());
@@ -355,25 +361,42 @@ fn initiate_response_for_another_object_aborts() {
 #[test]
 fn unexpected_or_unparsable_responses_abort_with_invalid_command() {
     let invalid = [0x80, 0x00, 0x10, 0x00, 0x01, 0x00, 0x04, 0x05];
-    let answers: [&[u8]; 3] = [
-        // A download initiate response to an upload.
-        &[0x60, 0x00, 0x10, 0x00, 0, 0, 0, 0],
-        // No such command specifier.
-        &[0xE0, 0, 0, 0, 0, 0, 0, 0],
-        // SDO frames have 8 bytes.
-        &[0x43, 0x00, 0x10],
+    let bad = |frame: &[u8], error| {
+        let mut bytes = [0u8; 8];
+        bytes[..frame.len()].copy_from_slice(frame);
+        SdoError::BadResponse {
+            frame: bytes,
+            len: frame.len() as u8,
+            error,
+        }
+    };
+    let answers: [(&[u8], SdoError); 3] = [
+        // A download initiate response to an upload: a valid frame that
+        // does not fit the transfer.
+        (
+            &[0x60, 0x00, 0x10, 0x00, 0, 0, 0, 0],
+            local(AbortCode::InvalidCommand),
+        ),
+        // No such command specifier: the error names the frame.
+        (
+            &[0xE0, 0, 0, 0, 0, 0, 0, 0],
+            bad(&[0xE0, 0, 0, 0, 0, 0, 0, 0], ParseError::Command(0xE0)),
+        ),
+        // An expedited response of 4 bytes has 8.
+        (
+            &[0x43, 0x00, 0x10],
+            bad(&[0x43, 0x00, 0x10], ParseError::Short { len: 3, needed: 8 }),
+        ),
     ];
-    for answer in answers {
+    for (answer, error) in answers {
         let mut c = client();
         c.upload(ms(0), 0x1000, 0).unwrap();
         sent(&mut c);
         let frame = Frame::new(CanId::Standard(RESPONSE), answer).unwrap();
         c.handle_frame(ms(1), &frame);
         assert_eq!(one(&mut c), invalid);
-        assert_eq!(
-            events(&mut c),
-            failed(0x1000, 0, local(AbortCode::InvalidCommand))
-        );
+        assert_eq!(events(&mut c), failed(0x1000, 0, error));
+        assert_eq!(error.code(), AbortCode::InvalidCommand);
     }
 }
 
@@ -404,7 +427,8 @@ fn foreign_frames_are_ignored() {
         vec![ClientEvent::Uploaded {
             index: 0x1000,
             sub: 0,
-            data: vec![1, 2, 3, 4]
+            data: vec![1, 2, 3, 4],
+            padded: false
         }]
     );
 }

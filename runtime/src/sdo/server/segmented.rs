@@ -12,7 +12,8 @@ impl<S: ObjectStore> SdoServer<S> {
         let (index, sub) = self.object;
         match data {
             Initiate::Expedited { data, len } => {
-                let len = usize::from(len).clamp(1, data.len());
+                // Without an indicated size, the frame's 4 bytes are the value.
+                let len = usize::from(len.unwrap_or(4)).clamp(1, data.len());
                 let value = data.get(..len).unwrap_or(&data);
                 if len > self.config.max_download {
                     return self.fail(AbortCode::OutOfMemory);
@@ -116,7 +117,7 @@ impl<S: ObjectStore> SdoServer<S> {
                 sub,
                 data: Initiate::Expedited {
                     data,
-                    len: len as u8,
+                    len: Some(len as u8),
                 },
             });
             self.succeed(ServerEvent::Uploaded { index, sub, len });

@@ -167,7 +167,8 @@ fn block_upload_with_a_lost_segment() {
         vec![ClientEvent::Uploaded {
             index: 0x1F50,
             sub: 1,
-            data: data.to_vec()
+            data: data.to_vec(),
+            padded: false
         }]
     );
     assert!(c.is_idle());
@@ -198,7 +199,8 @@ fn block_upload_over_several_sub_blocks_without_size() {
         vec![ClientEvent::Uploaded {
             index: 0x2000,
             sub: 0,
-            data: (1..=15).collect()
+            data: (1..=15).collect(),
+            padded: false
         }]
     );
 }
@@ -315,7 +317,8 @@ fn block_upload_follows_a_protocol_switch() {
         vec![ClientEvent::Uploaded {
             index: 0x1008,
             sub: 0,
-            data: vec![0x34, 0x12]
+            data: vec![0x34, 0x12],
+            padded: false
         }]
     );
     // Segmented answer: continue with upload segment requests.
@@ -329,7 +332,8 @@ fn block_upload_follows_a_protocol_switch() {
         vec![ClientEvent::Uploaded {
             index: 0x1008,
             sub: 0,
-            data: b"abc".to_vec()
+            data: b"abc".to_vec(),
+            padded: false
         }]
     );
 }
