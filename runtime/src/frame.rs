@@ -113,6 +113,22 @@ impl Frame {
         }
     }
 
+    /// A data frame on `id` from parts the caller knows are valid: the id
+    /// is masked to its width (11 or 29 bits) and `len` clamped to 8.
+    pub const fn with_id(id: CanId, data: [u8; 8], len: u8) -> Frame {
+        let len = if len > 8 { 8 } else { len };
+        let id = match id {
+            CanId::Standard(id) => CanId::Standard(id & 0x7FF),
+            CanId::Extended(id) => CanId::Extended(id & 0x1FFF_FFFF),
+        };
+        Frame {
+            id,
+            rtr: false,
+            len,
+            data,
+        }
+    }
+
     pub const fn id(&self) -> CanId {
         self.id
     }

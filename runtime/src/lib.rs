@@ -4,15 +4,17 @@
 //!   implements (entries as zero-sized types with type-level access rights,
 //!   value conversion, PDO structs, node ids). Needs only `core`.
 //! - [`frame`], [`time`]: classic CAN frames, CANopen identifiers, and the
-//!   caller-supplied clock of the protocol cores.
+//!   caller-supplied monotonic clock of the protocol cores ([`time`] is not
+//!   the TIME service; that is [`time_stamp`]).
 //! - Protocol cores, sans-IO (fed frames and the current time; they return
 //!   frames to send, events and their next deadline through [`Service`]):
 //!   [`sdo`] (client and server: expedited, segmented, block), [`nmt`]
 //!   (master and slave), [`heartbeat`] (producer and consumer), [`guarding`]
 //!   (node guarding, both sides), [`emcy`] (consumer, error tables), [`sync`]
-//!   (producer and consumer), [`pdo`] (RPDO transmitter, TPDO receiver,
-//!   mapping configuration over SDO), [`lss`] (CiA 305 master and slave),
-//!   [`cia402`] (drive helper and device state machine).
+//!   (producer and consumer), [`time_stamp`] (the TIME service: producer,
+//!   consumer and the TIME_OF_DAY codec), [`pdo`] (RPDO transmitter, TPDO
+//!   receiver, mapping configuration over SDO), [`lss`] (CiA 305 master and
+//!   slave), [`cia402`] (drive helper and device state machine).
 //! - With `std`: [`transport`] (the virtual bus, candump logs, fault
 //!   injection, SocketCAN, `embedded-can`) and the drivers [`blocking`] and,
 //!   with `tokio`, `tokio`.
@@ -44,6 +46,7 @@ mod queue;
 pub mod sdo;
 pub mod sync;
 pub mod time;
+pub mod time_stamp;
 
 #[cfg(feature = "std")]
 pub mod blocking;
@@ -58,6 +61,7 @@ pub mod transport;
 pub use eds2rust_derive::Pdo;
 pub use frame::{CanId, Frame};
 pub use time::{Deadline, Instant};
+pub use time_stamp::{TimeDifference, TimeOfDay};
 
 /// The interface every sans-IO protocol core offers (the style of
 /// quinn-proto): the caller feeds received frames and the current time, then

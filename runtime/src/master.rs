@@ -3,7 +3,8 @@
 //!
 //! [`Master`] holds an [`NmtMaster`], the master's own
 //! [`HeartbeatProducer`], a [`HeartbeatConsumer`], an optional
-//! [`SyncProducer`], an [`EmcyConsumer`], an [`LssMaster`], a
+//! [`SyncProducer`], an [`EmcyConsumer`], a [`TimeConsumer`] and an
+//! optional [`TimeProducer`] (the TIME service), an [`LssMaster`], a
 //! [`PdoReceiver`] for the devices' TPDOs, any number of
 //! [`PdoTransmitter`]s for their RPDOs, and one SDO client core per server
 //! node. Every received frame goes to every core; each core's timer runs;
@@ -61,6 +62,7 @@ use crate::sdo::Channel;
 use crate::sdo::client::{ClientConfig, ClientEvent, SdoClient};
 use crate::sync::SyncProducer;
 use crate::time::earliest;
+use crate::time_stamp::{TimeConsumer, TimeEvent, TimeProducer};
 use crate::{Frame, Instant, Service};
 
 /// Number of TPDOs the master's [`PdoReceiver`] can watch.
@@ -71,8 +73,9 @@ pub const PDO_RX_SLOTS: usize = 32;
 pub const SYNC_EVENTS: usize = 8;
 
 /// Cores with a fixed place in the transmit rotation: NMT, heartbeat
-/// producer, heartbeat consumer, SYNC, EMCY, LSS, PDO receiver.
-const FIXED_CORES: usize = 7;
+/// producer, heartbeat consumer, SYNC, EMCY, LSS, PDO receiver, TIME
+/// producer.
+const FIXED_CORES: usize = 8;
 
 /// What one of the master's cores reported.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -86,6 +89,9 @@ pub enum MasterEvent {
     Sync(Option<u8>),
     /// The EMCY consumer received an emergency message.
     Emcy(EmcyEvent),
+    /// The TIME consumer received a TIME frame (decoded, or malformed with
+    /// the frame and the reason).
+    Time(TimeEvent),
     /// The LSS request in progress ended.
     Lss(LssEvent),
     /// The PDO receiver got a TPDO, a length error or a timeout.
@@ -115,6 +121,13 @@ pub struct Master {
     pub sync: Option<SyncProducer>,
     /// Receives the emergency messages of all nodes.
     pub emcy: EmcyConsumer,
+    /// Decodes the TIME frames on 0x100 (reconfigure with
+    /// [`TimeConsumer::with_id`]); `None` ignores TIME frames.
+    pub time_rx: Option<TimeConsumer>,
+    /// The TIME producer, if the master produces TIME (started by
+    /// [`Master::start`]; give it the wall-clock time with
+    /// [`TimeProducer::set_time`]).
+    pub time_tx: Option<TimeProducer>,
     /// Runs LSS requests (CiA 305).
     pub lss: LssMaster,
     /// Receives the devices' TPDOs.
@@ -142,6 +155,8 @@ impl Master {
             consumer: HeartbeatConsumer::new(),
             sync: None,
             emcy: EmcyConsumer::new(),
+            time_rx: Some(TimeConsumer::new()),
+            time_tx: None,
             lss: LssMaster::new(),
             pdo_rx: PdoReceiver::new(),
             pdo_tx: Vec::new(),
@@ -159,12 +174,15 @@ impl Master {
     }
 
     /// Starts the heartbeat producer (boot-up message now, heartbeats every
-    /// period) and the SYNC producer, if any.
+    /// period), the SYNC producer and the TIME producer, if any.
     pub fn start(&mut self, now: Instant) {
         self.now = now;
         self.heartbeat.start(now);
         if let Some(sync) = &mut self.sync {
             sync.start(now);
+        }
+        if let Some(time) = &mut self.time_tx {
+            time.start(now);
         }
     }
 
@@ -244,6 +262,7 @@ impl Master {
             4 => self.emcy.poll_transmit(),
             5 => self.lss.poll_transmit(),
             6 => self.pdo_rx.poll_transmit(),
+            7 => self.time_tx.as_mut()?.poll_transmit(),
             i => {
                 let i = i - FIXED_CORES;
                 match self.pdo_tx.get_mut(i) {
@@ -287,6 +306,9 @@ impl Service for Master {
         self.nmt.handle_frame(now, frame);
         self.consumer.handle_frame(now, frame);
         self.emcy.handle_frame(now, frame);
+        if let Some(time) = &mut self.time_rx {
+            time.handle_frame(now, frame);
+        }
         self.lss.handle_frame(now, frame);
         self.pdo_rx.handle_frame(now, frame);
         for tx in &mut self.pdo_tx {
@@ -309,6 +331,9 @@ impl Service for Master {
         timeout_if_due(&mut self.emcy, now);
         timeout_if_due(&mut self.lss, now);
         timeout_if_due(&mut self.pdo_rx, now);
+        if let Some(time) = &mut self.time_tx {
+            timeout_if_due(time, now);
+        }
         for tx in &mut self.pdo_tx {
             timeout_if_due(tx, now);
         }
@@ -318,8 +343,8 @@ impl Service for Master {
     }
 
     /// Takes one frame from the next core that has one, in rotation: NMT,
-    /// heartbeat, SYNC, LSS, the PDO transmitters, then the SDO clients by
-    /// node id.
+    /// heartbeat, SYNC, LSS, TIME, the PDO transmitters, then the SDO
+    /// clients by node id.
     fn poll_transmit(&mut self) -> Option<Frame> {
         let count = self.core_count();
         for k in 0..count {
@@ -333,7 +358,7 @@ impl Service for Master {
     }
 
     /// Events in a fixed order of cores: NMT, heartbeat consumer, SYNC,
-    /// EMCY, LSS, PDO receiver, SDO clients by node id.
+    /// EMCY, TIME, LSS, PDO receiver, SDO clients by node id.
     fn poll_event(&mut self) -> Option<MasterEvent> {
         if let Some(e) = self.nmt.poll_event() {
             return Some(MasterEvent::Nmt(e));
@@ -346,6 +371,9 @@ impl Service for Master {
         }
         if let Some(e) = self.emcy.poll_event() {
             return Some(MasterEvent::Emcy(e));
+        }
+        if let Some(e) = self.time_rx.as_mut().and_then(Service::poll_event) {
+            return Some(MasterEvent::Time(e));
         }
         if let Some(e) = self.lss.poll_event() {
             return Some(MasterEvent::Lss(e));
@@ -366,6 +394,7 @@ impl Service for Master {
         at = earliest(at, self.emcy.poll_timeout());
         at = earliest(at, self.lss.poll_timeout());
         at = earliest(at, self.pdo_rx.poll_timeout());
+        at = earliest(at, self.time_tx.as_ref().and_then(Service::poll_timeout));
         for tx in &self.pdo_tx {
             at = earliest(at, tx.poll_timeout());
         }

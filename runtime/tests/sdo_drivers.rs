@@ -51,10 +51,7 @@ const REQUEST: u16 = 0x605;
 const RESPONSE: u16 = 0x585;
 
 fn config(timeout: Duration) -> ClientConfig {
-    let mut config = ClientConfig::new(Channel {
-        request: REQUEST,
-        response: RESPONSE,
-    });
+    let mut config = ClientConfig::new(Channel::standard(REQUEST, RESPONSE));
     config.timeout = timeout;
     config
 }

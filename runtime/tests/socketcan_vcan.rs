@@ -1,7 +1,7 @@
 //! [`SocketCanBus`] against the kernel's SocketCAN stack: classic frames
 //! between two sockets, kernel filters, receive timeouts, and SDO transfers
 //! (expedited, segmented, block) between the blocking client and a served
-//! SDO server.
+//! SDO server, also on an additional 29-bit SDO channel.
 //!
 //! These tests need a real CAN interface and are ignored by default:
 //! `tests/vm/run.sh` runs them with `--ignored` inside a VM whose kernel has
@@ -30,6 +30,7 @@ const TIMEOUTS: usize = 2;
 const SDO: usize = 3;
 #[cfg(feature = "tokio")]
 const ASYNC: usize = 4;
+const SDO_29_BIT: usize = 5;
 
 /// Waits for frames that must arrive; generous for an emulated VM.
 const ARRIVAL: Duration = Duration::from_secs(2);
@@ -202,7 +203,7 @@ fn sdo_transfers_between_client_and_served_server() {
     let name = iface(SDO);
     let node = NodeId::new(5).unwrap();
     let channel = Channel::default_for(node);
-    assert_eq!((channel.request, channel.response), (0x605, 0x585));
+    assert_eq!(channel, Channel::standard(0x605, 0x585));
 
     let long: Vec<u8> = (0..1000u32).map(|i| (i * 7 + 3) as u8).collect();
     let text = b"eds2rust over vcan!".to_vec();
@@ -215,12 +216,8 @@ fn sdo_transfers_between_client_and_served_server() {
 
     // Sees every frame of the transfers.
     let mut sniffer = open(&name);
-    let server_bus = open(&name)
-        .set_filters(&[(channel.request, 0x7FF)])
-        .unwrap();
-    let client_bus = open(&name)
-        .set_filters(&[(channel.response, 0x7FF)])
-        .unwrap();
+    let server_bus = open(&name).set_id_filters(&[channel.request]).unwrap();
+    let client_bus = open(&name).set_id_filters(&[channel.response]).unwrap();
 
     let stop = Arc::new(AtomicBool::new(false));
     let server_stop = Arc::clone(&stop);
@@ -290,6 +287,90 @@ fn sdo_transfers_between_client_and_served_server() {
     );
 }
 
+/// An SDO server with an additional 29-bit channel (what a device's 0x1201
+/// with bit 29 in its COB-IDs configures) and a client on that channel:
+/// the frames cross the kernel as extended frames, and the default 11-bit
+/// channel still answers.
+#[test]
+#[ignore = "needs a SocketCAN interface in CAN_IFACE: run by tests/vm/run.sh"]
+fn sdo_on_an_additional_29_bit_channel() {
+    let name = iface(SDO_29_BIT);
+    let node = NodeId::new(7).unwrap();
+    let default = Channel::default_for(node);
+    // COB-IDs as 0x1201 sub 1 and 2 hold them: bit 29 set, 29-bit ids.
+    let extended = Channel::from_cob_ids(0x2000_0000 | 0x1ABC_0607, 0x2000_0000 | 0x1ABC_0587)
+        .expect("valid 29-bit COB-IDs");
+    assert_eq!(extended, Channel::extended(0x1ABC_0607, 0x1ABC_0587));
+    assert_eq!(extended.cob_ids(), (0x3ABC_0607, 0x3ABC_0587));
+
+    let long: Vec<u8> = (0..300u32).map(|i| (i * 11 + 5) as u8).collect();
+    let mut store = MemoryStore::new();
+    store.insert(0x2000, 0, AccessRight::Rw, &[0x01, 0x02, 0x03, 0x04]);
+    store.insert(0x2001, 0, AccessRight::Rw, &long);
+
+    let mut sniffer = open(&name);
+    let server_bus = open(&name)
+        .set_id_filters(&[default.request, extended.request])
+        .unwrap();
+    let client_bus = open(&name).set_id_filters(&[extended.response]).unwrap();
+    let default_bus = open(&name).set_id_filters(&[default.response]).unwrap();
+
+    let stop = Arc::new(AtomicBool::new(false));
+    let server_stop = Arc::clone(&stop);
+    let server = std::thread::spawn(move || {
+        let mut bus = server_bus;
+        let mut server = SdoServer::new(ServerConfig::new(default), store);
+        server.set_extra_channels(vec![extended]);
+        let deadline = Instant::now() + Duration::from_secs(60);
+        blocking::serve(
+            &mut bus,
+            &Clock::new(),
+            &mut server,
+            &server_stop,
+            Some(deadline),
+            |_| {},
+        )
+        .map(|()| server.into_store())
+    });
+
+    let mut client = SdoClient::new(client_bus, ClientConfig::new(extended));
+    let mut default_client = SdoClient::new(default_bus, ClientConfig::new(default));
+    let results = (|| -> Result<(), blocking::Error> {
+        assert_eq!(client.upload(0x2000, 0)?, [0x01, 0x02, 0x03, 0x04]);
+        client.download_with(0x2001, 0, &long[..100], Method::Segmented)?;
+        assert_eq!(client.upload_with(0x2001, 0, Method::Block)?, &long[..100]);
+        // The default channel is served as well.
+        assert_eq!(default_client.upload(0x2000, 0)?, [0x01, 0x02, 0x03, 0x04]);
+        Ok(())
+    })();
+    stop.store(true, Ordering::Relaxed);
+    let store = server.join().unwrap().unwrap();
+    results.unwrap();
+    assert_eq!(store.get(0x2001, 0), Some(&long[..100]));
+
+    // On the wire: an extended-frame initiate request and its answer.
+    assert_eq!(
+        sniffer.recv(ARRIVAL).unwrap(),
+        Some(
+            Frame::new(
+                CanId::Extended(0x1ABC_0607),
+                &[0x40, 0x00, 0x20, 0x00, 0, 0, 0, 0]
+            )
+            .unwrap()
+        )
+    );
+    assert_eq!(
+        sniffer.recv(ARRIVAL).unwrap(),
+        Some(
+            Frame::new(
+                CanId::Extended(0x1ABC_0587),
+                &[0x43, 0x00, 0x20, 0x00, 1, 2, 3, 4]
+            )
+            .unwrap()
+        )
+    );
+}
+
 /// The tokio transport: frames both ways with a filter, then expedited,
 /// segmented and block SDO transfers between the async client and an
 /// async-served server, each on its own `AsyncSocketCanBus`.
@@ -324,10 +405,10 @@ async fn tokio_transport_frames_filters_and_sdo() {
     store.insert(0x2000, 0, AccessRight::Rw, &[0x78, 0x56, 0x34, 0x12]);
     store.insert(0x2001, 0, AccessRight::Rw, &long);
     let mut server_bus = open_async(&name)
-        .set_filters(&[(channel.request, 0x7FF)])
+        .set_id_filters(&[channel.request])
         .unwrap();
     let client_bus = open_async(&name)
-        .set_filters(&[(channel.response, 0x7FF)])
+        .set_id_filters(&[channel.response])
         .unwrap();
     let (stop_tx, stop_rx) = tokio::sync::oneshot::channel::<()>();
     let server = tokio::spawn(async move {

@@ -205,6 +205,7 @@ impl<B: Behaviour> Device<B> {
         d.now = now;
         let Some(node) = d.node else {
             self.heartbeat = None;
+            self.server.set_extra_channels(Vec::new());
             return;
         };
         let period = d.table.get_uint(0x1017, 0).unwrap_or(0);
@@ -212,6 +213,7 @@ impl<B: Behaviour> Device<B> {
         producer.start(now);
         self.heartbeat = Some(producer);
         self.configure_consumer();
+        self.configure_extra_sdo();
         self.set_nmt(now, NmtState::PreOperational);
     }
 
@@ -225,6 +227,22 @@ impl<B: Behaviour> Device<B> {
         let node = self.node();
         self.server.set_channel(server_config(node).channel);
         self.boot(now);
+    }
+
+    /// The additional server SDO channels of the table (0x1201 to 0x127F:
+    /// sub 1 client to server, sub 2 server to client; 11- or 29-bit, those
+    /// with bit 31 set are not in use). The server serves them besides its
+    /// default channel, one transfer at a time.
+    fn configure_extra_sdo(&mut self) {
+        let table = &self.server.store().table;
+        let channels: Vec<Channel> = (0x1201..=0x127F)
+            .filter_map(|index| {
+                let request = table.get_uint(index, 1)?;
+                let response = table.get_uint(index, 2)?;
+                Channel::from_cob_ids(request as u32, response as u32).ok()
+            })
+            .collect();
+        self.server.set_extra_channels(channels);
     }
 
     fn configure_consumer(&mut self) {
@@ -340,6 +358,7 @@ impl<B: Behaviour> Device<B> {
                     }
                 }
                 0x1016 => self.configure_consumer(),
+                0x1201..=0x127F => self.configure_extra_sdo(),
                 0x1400..=0x1BFF => pdo_changed = true,
                 _ => {}
             }
@@ -489,10 +508,7 @@ impl<B: Behaviour> Device<B> {
 fn server_config(node: Option<NodeId>) -> ServerConfig {
     let channel = match node {
         Some(node) => Channel::default_for(node),
-        None => Channel {
-            request: 0x600,
-            response: 0x580,
-        },
+        None => Channel::standard(0x600, 0x580),
     };
     ServerConfig::new(channel)
 }

@@ -322,3 +322,56 @@ fn an_unconfigured_lss_slave_gets_its_node_id_and_moves_its_sdo_server() {
     let vendor = b.upload(node(9), 0x1018, 1).expect("vendor id");
     assert_eq!(vendor, example::VENDOR_ID.to_le_bytes());
 }
+
+/// An additional server SDO (0x1201) configured over the default channel
+/// with 29-bit COB-IDs (bit 29 set): the device then answers on it with
+/// extended frames, as well as on its default channel.
+#[test]
+fn an_additional_sdo_channel_with_29_bit_ids_is_served() {
+    use eds2rust_runtime::od::{AccessRight, DataType, DefaultValue, Number, ObjectInfo};
+    use eds2rust_runtime::sdo::Channel;
+    use eds2rust_runtime::sdo::client::ClientConfig;
+
+    let record = |sub, name, access, default: u32| {
+        let data_type = if sub == 0 { DataType::Unsigned8 } else { DataType::Unsigned32 };
+        ObjectInfo::new(0x1201, sub, name, data_type, access, false)
+            .with_default(DefaultValue::Number(Number::Int(i128::from(default))))
+    };
+    let mut table: Vec<ObjectInfo> = example::od::OBJECTS.to_vec();
+    table.extend([
+        record(0, "Highest sub-index supported", AccessRight::Const, 2),
+        // Not valid (bit 31) until configured.
+        record(1, "COB-ID client to server", AccessRight::Rw, 0x8000_0000),
+        record(2, "COB-ID server to client", AccessRight::Rw, 0x8000_0000),
+    ]);
+    table.sort_by_key(|o| (o.index, o.subindex));
+    let table: &'static [ObjectInfo] = Box::leak(table.into_boxed_slice());
+    let device = Device::new(table, DeviceConfig::node(node(5)), (), Instant::ZERO);
+    let mut b = Bench::new(Master::new(node(1), Duration::ZERO), device, Instant::ZERO);
+    b.run_for(Duration::from_millis(10));
+
+    // The master reaches the second channel through a client of its own,
+    // kept under an unused node id.
+    let extended = Channel::extended(0x1ABC_0605, 0x1ABC_0585);
+    let via = node(100);
+    b.master.add_sdo_client(via, ClientConfig::new(extended));
+    // Not configured yet: nobody answers on the 29-bit ids.
+    assert_eq!(b.upload(via, 0x1000, 0), Err(SdoError::Timeout));
+
+    let (request, response) = extended.cob_ids();
+    assert_eq!((request, response), (0x3ABC_0605, 0x3ABC_0585));
+    b.download(node(5), 0x1201, 2, &response.to_le_bytes()).expect("0x1201.2");
+    b.download(node(5), 0x1201, 1, &request.to_le_bytes()).expect("0x1201.1");
+    let device_type = b.upload(node(5), 0x1000, 0).expect("default channel");
+    let start = b.trace.len();
+    assert_eq!(b.upload(via, 0x1000, 0).expect("29-bit channel"), device_type);
+    let ids: Vec<CanId> = b.trace[start..].iter().map(|(_, f)| f.id()).collect();
+    assert_eq!(
+        ids,
+        [CanId::Extended(0x1ABC_0605), CanId::Extended(0x1ABC_0585)]
+    );
+    // Marked not valid again: the channel is gone.
+    b.download(node(5), 0x1201, 1, &(request | 0x8000_0000).to_le_bytes())
+        .expect("0x1201.1");
+    assert_eq!(b.upload(via, 0x1000, 0), Err(SdoError::Timeout));
+}

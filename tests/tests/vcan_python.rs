@@ -179,9 +179,7 @@ fn our_sdo_client_against_python_local_node() {
     }));
     assert_eq!(peer.read(), json!({"ready": true}));
 
-    let bus = open(&name)
-        .set_filters(&[(channel.response, 0x7FF)])
-        .unwrap();
+    let bus = open(&name).set_id_filters(&[channel.response]).unwrap();
     let mut client = SdoClient::new(bus, ClientConfig::new(channel));
     let long: Vec<u8> = (0..100u8).map(|i| i.wrapping_mul(13) ^ 0x5A).collect();
     // Expedited upload and download.
@@ -254,9 +252,7 @@ fn python_remote_node_against_our_sdo_server() {
     store.insert(0x2003, 0, AccessRight::Rw, &[0x00]);
     store.insert(0x2004, 0, AccessRight::Rw, &[0x00]);
 
-    let server_bus = open(&name)
-        .set_filters(&[(channel.request, 0x7FF)])
-        .unwrap();
+    let server_bus = open(&name).set_id_filters(&[channel.request]).unwrap();
     let stop = Arc::new(AtomicBool::new(false));
     let server_stop = Arc::clone(&stop);
     let server = std::thread::spawn(move || {

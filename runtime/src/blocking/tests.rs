@@ -224,10 +224,7 @@ fn visible_strings() {
 
 #[test]
 fn transfer_bound_counts_steps() {
-    let mut config = ClientConfig::new(crate::sdo::Channel {
-        request: 0x601,
-        response: 0x581,
-    });
+    let mut config = ClientConfig::new(crate::sdo::Channel::standard(0x601, 0x581));
     config.timeout = Duration::from_millis(100);
     config.max_upload = 70;
     // 70 bytes: 10 segments + 4 = 14 steps.

@@ -189,15 +189,9 @@ fn sdo_clients_are_kept_per_node() {
     assert!(m.sdo(node(7)).is_none());
     assert_eq!(
         m.sdo_or_default(node(7)).config().channel,
-        Channel {
-            request: 0x607,
-            response: 0x587
-        }
+        Channel::standard(0x607, 0x587)
     );
-    let custom = Channel {
-        request: 0x640,
-        response: 0x5C0,
-    };
+    let custom = Channel::standard(0x640, 0x5C0);
     m.add_sdo_client(node(7), ClientConfig::new(custom));
     m.add_sdo_client(node(3), ClientConfig::new(Channel::default_for(node(3))));
     assert_eq!(m.sdo(node(7)).unwrap().config().channel, custom);
@@ -205,4 +199,61 @@ fn sdo_clients_are_kept_per_node() {
     assert!(m.remove_sdo_client(node(3)).is_some());
     assert_eq!(m.sdo_nodes().collect::<Vec<_>>(), [node(7)]);
     assert_eq!(m.node(), node(1));
+}
+
+#[test]
+fn time_frames_become_events_and_the_master_can_produce_time() {
+    use crate::time_stamp::{DateTime, TimeError, TimeEvent, TimeOfDay, TimeProducer};
+    let mut m = Master::new(node(1), Duration::ZERO);
+    m.start(ms(0));
+    drain_frames(&mut m);
+    // 2026-12-02T12:34:56.789Z: 45_296_789 ms = 0x02B3_2C95, day 15_676 =
+    // 0x3D3C (the hand-worked frame of time_stamp::tests).
+    m.handle_frame(ms(1), &frame(0x100, &[0x95, 0x2C, 0xB3, 0x02, 0x3C, 0x3D]));
+    // Between the EMCY and the PDO events.
+    m.handle_frame(ms(2), &frame(0x085, &[0x10, 0x32, 0x05, 0, 0, 0, 0, 0]));
+    // Too short, and reserved bits set: events naming the frame.
+    m.handle_frame(ms(3), &frame(0x100, &[0x95, 0x2C, 0xB3]));
+    m.handle_frame(ms(4), &frame(0x100, &[0, 0, 0, 0x80, 0, 0]));
+    let time = TimeOfDay::from_civil(DateTime::new(2026, 12, 2, 12, 34, 56, 789)).unwrap();
+    assert_eq!(
+        drain_events(&mut m),
+        [
+            MasterEvent::Emcy(EmcyEvent::Emergency {
+                node: node(5),
+                emcy: Emcy::parse(&[0x10, 0x32, 0x05, 0, 0, 0, 0, 0]).unwrap()
+            }),
+            MasterEvent::Time(TimeEvent::Time {
+                time,
+                received: ms(1)
+            }),
+            MasterEvent::Time(TimeEvent::Malformed {
+                frame: frame(0x100, &[0x95, 0x2C, 0xB3]),
+                error: TimeError::Length(3)
+            }),
+            MasterEvent::Time(TimeEvent::Malformed {
+                frame: frame(0x100, &[0, 0, 0, 0x80, 0, 0]),
+                error: TimeError::ReservedBits(8)
+            }),
+        ]
+    );
+    assert_eq!(m.time_rx.as_ref().unwrap().last(), Some((ms(1), time)));
+    // Without a consumer TIME frames are ignored.
+    m.time_rx = None;
+    m.handle_frame(ms(5), &frame(0x100, &[0; 6]));
+    assert_eq!(drain_events(&mut m), []);
+
+    // A TIME producer every second, from the start.
+    let mut m = Master::new(node(1), Duration::ZERO);
+    let mut producer = TimeProducer::new(Duration::from_secs(1));
+    producer.set_time(ms(0), time);
+    m.time_tx = Some(producer);
+    m.start(ms(0));
+    assert_eq!(m.poll_timeout(), Some(ms(0)));
+    m.handle_timeout(ms(0));
+    assert_eq!(drain_frames(&mut m), ["701#00", "100#952CB3023C3D"]);
+    assert_eq!(m.poll_timeout(), Some(ms(1000)));
+    m.handle_timeout(ms(1000));
+    // 45_297_789 ms = 0x02B3_307D.
+    assert_eq!(drain_frames(&mut m), ["100#7D30B3023C3D"]);
 }

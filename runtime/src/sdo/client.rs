@@ -3,9 +3,9 @@
 //!
 //! Expedited, segmented and block transfers in both directions; every frame
 //! is built and parsed by [`super::proto`]. The client sends on
-//! [`Channel::request`] and listens only to standard-id data frames on
-//! [`Channel::response`]; it ignores everything else, and every frame while
-//! idle.
+//! [`Channel::request`] and listens only to data frames on
+//! [`Channel::response`] (11- or 29-bit, as the channel says); it ignores
+//! everything else, and every frame while idle.
 //!
 //! Each step waits [`ClientConfig::timeout`] for the server's next frame. A
 //! transfer ends with exactly one [`ClientEvent`]. When the client ends it
@@ -564,10 +564,7 @@ impl Service for SdoClient {
     type Event = ClientEvent;
 
     fn handle_frame(&mut self, now: Instant, frame: &Frame) {
-        if self.is_idle()
-            || frame.is_remote()
-            || frame.cob_id() != Some(self.config.channel.response)
-        {
+        if self.is_idle() || frame.is_remote() || frame.id() != self.config.channel.response {
             return;
         }
         let data = frame.data();
@@ -617,7 +614,7 @@ impl Service for SdoClient {
             Some(data) => data,
             None => self.next_block_segment()?,
         };
-        Some(Frame::standard(self.config.channel.request, data, 8))
+        Some(Frame::with_id(self.config.channel.request, data, 8))
     }
 
     fn poll_event(&mut self) -> Option<ClientEvent> {

@@ -1,10 +1,14 @@
-//! SDO server (CiA 301) for one channel, as a sans-IO state machine over an
-//! [`ObjectStore`].
+//! SDO server (CiA 301) as a sans-IO state machine over an [`ObjectStore`].
 //!
 //! It serves expedited, segmented and block downloads and uploads, one
 //! transfer at a time, and answers on [`Channel::response`] every request it
 //! receives on [`Channel::request`] (other frames are ignored). Every frame
-//! is parsed and built by [`super::proto`].
+//! is parsed and built by [`super::proto`]. Besides its own channel
+//! ([`ServerConfig::channel`], the default SDO) it can listen on additional
+//! channels, 11- or 29-bit ([`SdoServer::set_extra_channels`], what a
+//! device's 0x1201–0x127F configure). It still runs one transfer at a time:
+//! a request on another channel while one runs is answered there with abort
+//! 0x08000022 (not now: the present device state).
 //!
 //! Choices where CiA 301 leaves room:
 //! - An initiate request while a transfer runs restarts: the old transfer is
@@ -31,7 +35,7 @@ use core::time::Duration;
 
 use super::proto::{ParseError, Request, Response};
 use super::{AbortCode, Channel, DEFAULT_TIMEOUT, MAX_BLOCK_SIZE, SdoError};
-use crate::{Frame, Instant, Service};
+use crate::{CanId, Frame, Instant, Service};
 
 mod block;
 mod memory;
@@ -158,7 +162,12 @@ pub struct SdoServer<S> {
     buf: Vec<u8>,
     /// When the client's next frame is due (running transfers only).
     deadline: Option<Instant>,
-    outbox: Ring<[u8; 8], OUTBOX>,
+    /// Additional channels besides the configured one.
+    extra: Vec<Channel>,
+    /// The channel of the running transfer (the configured one while idle).
+    active: Channel,
+    /// Responses and the identifier each goes out on.
+    outbox: Ring<(CanId, [u8; 8]), OUTBOX>,
     events: Ring<ServerEvent, OUTBOX>,
 }
 
@@ -167,12 +176,14 @@ impl<S: ObjectStore> SdoServer<S> {
     /// needs a buffer.
     pub fn new(config: ServerConfig, store: S) -> SdoServer<S> {
         SdoServer {
+            active: config.channel,
             config,
             store,
             state: State::Idle,
             object: (0, 0),
             buf: Vec::new(),
             deadline: None,
+            extra: Vec::new(),
             outbox: Ring::new(),
             events: Ring::new(),
         }
@@ -203,9 +214,60 @@ impl<S: ObjectStore> SdoServer<S> {
     /// an answer, as the node it belonged to is gone.
     pub fn set_channel(&mut self, channel: Channel) {
         self.config.channel = channel;
+        self.drop_transfer();
+    }
+
+    /// Listens on `channels` as well as on the configured one (a device's
+    /// additional server SDO parameters 0x1201–0x127F; build them with
+    /// [`Channel::from_cob_ids`]). A running transfer on a channel no longer
+    /// listened to is dropped without an answer.
+    pub fn set_extra_channels(&mut self, channels: Vec<Channel>) {
+        self.extra = channels;
+        if self.active != self.config.channel && !self.extra.contains(&self.active) {
+            self.drop_transfer();
+        }
+    }
+
+    /// The additional channels.
+    pub fn extra_channels(&self) -> &[Channel] {
+        &self.extra
+    }
+
+    fn drop_transfer(&mut self) {
         self.state = State::Idle;
         self.deadline = None;
         self.buf.clear();
+        self.active = self.config.channel;
+    }
+
+    /// A request on `channel` while a transfer on another one runs: abort
+    /// 0x08000022 there (its index and sub-index when the frame has them),
+    /// nothing for an abort.
+    fn refuse_while_busy(&mut self, channel: Channel, data: &[u8]) {
+        let (index, sub) = match Request::parse(data) {
+            Ok(Request::Abort { .. }) => return,
+            Ok(
+                Request::DownloadInitiate { index, sub, .. }
+                | Request::UploadInitiate { index, sub }
+                | Request::BlockDownloadInitiate { index, sub, .. }
+                | Request::BlockUploadInitiate { index, sub, .. },
+            ) => (index, sub),
+            _ => (0, 0),
+        };
+        let abort = Response::Abort {
+            index,
+            sub,
+            code: AbortCode::CannotTransferDeviceState,
+        };
+        self.outbox.push((channel.response, abort.encode()));
+    }
+
+    /// The channel whose requests arrive on `id`.
+    fn channel_of(&self, id: CanId) -> Option<Channel> {
+        core::iter::once(&self.config.channel)
+            .chain(&self.extra)
+            .find(|c| c.request == id)
+            .copied()
     }
 
     /// No transfer running.
@@ -221,7 +283,7 @@ impl<S: ObjectStore> SdoServer<S> {
 
     /// Queues a response frame.
     fn send(&mut self, response: Response) {
-        self.outbox.push(response.encode());
+        self.outbox.push((self.active.response, response.encode()));
     }
 
     /// Ends the running transfer: back to idle, no deadline. A buffer grown
@@ -356,10 +418,21 @@ impl<S: ObjectStore> Service for SdoServer<S> {
     type Event = ServerEvent;
 
     fn handle_frame(&mut self, now: Instant, frame: &Frame) {
-        if frame.is_remote() || frame.cob_id() != Some(self.config.channel.request) {
+        if frame.is_remote() {
             return;
         }
+        let Some(channel) = self.channel_of(frame.id()) else {
+            return;
+        };
         let data = frame.data();
+        if channel != self.active {
+            if self.is_idle() {
+                self.active = channel;
+            } else {
+                self.refuse_while_busy(channel, data);
+                return;
+            }
+        }
         if let State::BlockDownload(ref transfer) = self.state
             && transfer.in_sub_block()
         {
@@ -400,11 +473,11 @@ impl<S: ObjectStore> Service for SdoServer<S> {
     }
 
     fn poll_transmit(&mut self) -> Option<Frame> {
-        let data = match self.outbox.pop() {
-            Some(data) => data,
-            None => self.next_upload_segment()?,
+        let (id, data) = match self.outbox.pop() {
+            Some(out) => out,
+            None => (self.active.response, self.next_upload_segment()?),
         };
-        Some(Frame::standard(self.config.channel.response, data, 8))
+        Some(Frame::with_id(id, data, 8))
     }
 
     fn poll_event(&mut self) -> Option<ServerEvent> {

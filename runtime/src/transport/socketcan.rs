@@ -77,6 +77,28 @@ fn filters(pairs: &[(u16, u16)]) -> Vec<CanFilter> {
         .collect()
 }
 
+/// Kernel filters that pass exactly the frames on `ids`: standard ones on
+/// their 11-bit identifier, extended ones on their 29-bit identifier.
+fn id_filters(ids: &[CanId]) -> Vec<CanFilter> {
+    ids.iter()
+        .map(|id| match *id {
+            CanId::Standard(id) => CanFilter::new(u32::from(id & 0x7FF), 0x7FF | CAN_EFF_FLAG),
+            CanId::Extended(id) => CanFilter::new(
+                (id & 0x1FFF_FFFF) | CAN_EFF_FLAG,
+                0x1FFF_FFFF | CAN_EFF_FLAG,
+            ),
+        })
+        .collect()
+}
+
+fn set_id_filters(socket: &impl SocketOptions, ids: &[CanId]) -> io::Result<()> {
+    if ids.is_empty() {
+        socket.set_filter_drop_all()
+    } else {
+        socket.set_filters(&id_filters(ids))
+    }
+}
+
 /// A blocking SocketCAN socket.
 #[derive(Debug)]
 pub struct SocketCanBus {
@@ -101,6 +123,13 @@ impl SocketCanBus {
     /// receives nothing.
     pub fn set_filters(self, pairs: &[(u16, u16)]) -> io::Result<SocketCanBus> {
         set_filters(&self.socket, pairs)?;
+        Ok(self)
+    }
+
+    /// Receives only the frames on `ids`, 11- or 29-bit (an SDO channel's
+    /// response identifier, say); an empty list receives nothing.
+    pub fn set_id_filters(self, ids: &[CanId]) -> io::Result<SocketCanBus> {
+        set_id_filters(&self.socket, ids)?;
         Ok(self)
     }
 
@@ -209,6 +238,13 @@ impl AsyncSocketCanBus {
         Ok(self)
     }
 
+    /// Receives only the frames on `ids` (see
+    /// [`SocketCanBus::set_id_filters`]).
+    pub fn set_id_filters(self, ids: &[CanId]) -> io::Result<AsyncSocketCanBus> {
+        set_id_filters(&self.socket, ids)?;
+        Ok(self)
+    }
+
     /// The interface name it was opened on.
     pub fn interface(&self) -> &str {
         &self.interface
@@ -260,6 +296,17 @@ mod tests {
             let converted = to_socketcan(&frame).unwrap();
             assert_eq!(from_socketcan(&converted), Some(frame));
         }
+    }
+
+    #[test]
+    fn id_filters_match_each_kind_exactly() {
+        assert_eq!(
+            id_filters(&[CanId::Standard(0x585), CanId::Extended(0x1ABC_0585)]),
+            [
+                CanFilter::new(0x585, 0x8000_07FF),
+                CanFilter::new(0x9ABC_0585, 0x9FFF_FFFF)
+            ]
+        );
     }
 
     #[test]

@@ -139,14 +139,14 @@ fn channel() -> Channel {
 
 /// Frames of the input are put on the server's request id (so that they
 /// reach it) unless their id already is an SDO id.
-fn to_channel(frames: Vec<(Duration, Frame)>, cob: u16) -> Vec<(Duration, Frame)> {
+fn to_channel(frames: Vec<(Duration, Frame)>, cob: CanId) -> Vec<(Duration, Frame)> {
     frames
         .into_iter()
         .map(|(step, f)| match f.cob_id() {
             Some(id) if !(0x580..=0x67F).contains(&id) && !f.is_remote() => {
                 let mut data = [0u8; 8];
                 data[..f.len()].copy_from_slice(f.data());
-                (step, Frame::standard(cob, data, f.len() as u8))
+                (step, Frame::with_id(cob, data, f.len() as u8))
             }
             _ => (step, f),
         })
@@ -162,7 +162,7 @@ pub fn sdo_server(data: &[u8]) {
     let mut server = SdoServer::new(config, test_store());
     let input = to_channel(frames(data), channel().request);
     drive(&mut server, &input, |_, frame| {
-        assert_eq!(frame.cob_id(), Some(channel().response));
+        assert_eq!(frame.id(), channel().response);
         assert_eq!(frame.len(), 8);
     });
     for (index, sub) in [(0x2000, 1), (0x2001, 0)] {
@@ -208,7 +208,7 @@ pub fn sdo_client(data: &[u8]) {
         while let Some(f) = client.poll_transmit() {
             sent += 1;
             assert!(sent <= MAX_FRAMES_PER_INPUT);
-            assert_eq!(f.cob_id(), Some(channel().request));
+            assert_eq!(f.id(), channel().request);
         }
         while client.poll_event().is_some() {
             ends += 1;

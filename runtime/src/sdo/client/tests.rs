@@ -13,10 +13,7 @@ const REQUEST: u16 = 0x601;
 const RESPONSE: u16 = 0x581;
 
 fn config() -> ClientConfig {
-    ClientConfig::new(Channel {
-        request: REQUEST,
-        response: RESPONSE,
-    })
+    ClientConfig::new(Channel::standard(REQUEST, RESPONSE))
 }
 
 fn client() -> SdoClient {
