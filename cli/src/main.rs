@@ -1,10 +1,15 @@
 //! The `eds2rust` command line: check, dump, export and diff CANopen object
-//! dictionaries, generate their Rust and list its API.
+//! dictionaries, generate their Rust and list its API; and talk to live
+//! nodes over SocketCAN (`sdo`, `nmt`, `scan`, `od upload|download`, `lss`:
+//! the `live` module, docs/live-bus.md).
 //!
 //! Exit status: 0 when no input has an error, 1 when one has, 2 on usage errors.
 //! `diff`: 0 without changes at the `--fail-on` level, 1 with, 2 on usage or
-//! input errors.
+//! input errors. Live commands: 0 done, 1 the operation failed on the bus,
+//! 2 usage errors.
 #![forbid(unsafe_code)]
+
+mod live;
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -18,7 +23,7 @@ use eds2rust::input::{Options, read_device};
 #[command(
     name = "eds2rust",
     version,
-    about = "Reads CANopen object dictionaries (EDS/DCF files and YAML object tables), reports on them and generates their Rust"
+    about = "Reads CANopen object dictionaries (EDS/DCF files and YAML object tables), reports on them and generates their Rust; talks to live nodes over SocketCAN"
 )]
 struct Cli {
     #[command(subcommand)]
@@ -119,6 +124,20 @@ enum Command {
         /// The new version: an EDS/DCF file or a YAML object table.
         new: PathBuf,
     },
+    /// Reads and writes objects of a live node by SDO (docs/live-bus.md).
+    #[command(subcommand)]
+    Sdo(live::SdoCommand),
+    /// Sends an NMT command to one node or all nodes.
+    Nmt(live::NmtArgs),
+    /// Lists the nodes on a bus: boot-up and heartbeat messages heard, SDO
+    /// probes of 0x1000 answered, with their identity (0x1018).
+    Scan(live::ScanArgs),
+    /// Backs up a live node's configuration into a DCF and writes it back.
+    #[command(subcommand)]
+    Od(live::OdCommand),
+    /// Layer setting services (CiA 305): fastscan, node ids.
+    #[command(subcommand)]
+    Lss(live::LssCommand),
 }
 
 /// How strictly to read, and the levels of single rules.
@@ -201,6 +220,9 @@ fn main() -> ExitCode {
         | Command::Generate { read, .. }
         | Command::Api { read, .. }
         | Command::Diff { read, .. } => read.options(),
+        Command::Sdo(_) | Command::Nmt(_) | Command::Scan(_) | Command::Od(_) | Command::Lss(_) => {
+            Ok(Options::default())
+        }
     };
     let options = match read {
         Ok(options) => options,
@@ -210,6 +232,11 @@ fn main() -> ExitCode {
         }
     };
     match cli.command {
+        Command::Sdo(cmd) => live::run_sdo(cmd),
+        Command::Nmt(args) => live::run_nmt(args),
+        Command::Scan(args) => live::run_scan(args),
+        Command::Od(cmd) => live::run_od(cmd),
+        Command::Lss(cmd) => live::run_lss(cmd),
         Command::Check { files, .. } => check(&files, &options),
         Command::Dump {
             format: Format::Json,

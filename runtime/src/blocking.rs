@@ -24,7 +24,9 @@ pub use crate::time::Deadline;
 use crate::transport::{Bus, Clock};
 use crate::{Instant, Service};
 
+mod error;
 mod master;
+mod stream;
 pub use master::{LssRequestError, MASTER_QUEUE_CAPACITY, Master};
 
 /// How often [`serve`] looks at its stop flag while nothing happens.
@@ -86,7 +88,15 @@ where
     S: Service + ?Sized,
 {
     let deadline = deadline.into().on(clock);
-    run(bus, clock, service, &mut until, deadline, None)
+    run(
+        bus,
+        clock,
+        service,
+        &mut until,
+        deadline,
+        None,
+        &mut |_, _| ControlFlow::Continue(()),
+    )
 }
 
 /// Runs `service` on `bus` (as [`drive`] does) until `stop` is set or
@@ -114,26 +124,41 @@ where
         ControlFlow::Continue(())
     };
     let deadline = deadline.into().on(clock);
-    match run(bus, clock, service, &mut until, deadline, Some(stop)) {
+    let mut no_hook = |_: &mut S, _| ControlFlow::Continue(());
+    match run(
+        bus,
+        clock,
+        service,
+        &mut until,
+        deadline,
+        Some(stop),
+        &mut no_hook,
+    ) {
         Ok(()) | Err(DriveError::Deadline | DriveError::Stopped) => Ok(()),
         Err(DriveError::Io(e)) => Err(e),
     }
 }
 
-/// The loop behind [`drive`] and [`serve`], in the cores' time.
-fn run<B, S, T>(
+/// The loop behind [`drive`] and [`serve`], in the cores' time. `hook`
+/// runs first in every round (streamed transfers feed and take data
+/// there); breaking from it stops the loop with [`DriveError::Stopped`].
+pub(crate) fn run<B, S, T>(
     bus: &mut B,
     clock: &Clock,
     service: &mut S,
     until: &mut impl FnMut(S::Event) -> ControlFlow<T>,
     deadline: Option<Instant>,
     stop: Option<&AtomicBool>,
+    hook: &mut dyn FnMut(&mut S, Instant) -> ControlFlow<()>,
 ) -> Result<T, DriveError>
 where
     B: Bus + ?Sized,
     S: Service + ?Sized,
 {
     loop {
+        if hook(service, clock.now()).is_break() {
+            return Err(DriveError::Stopped);
+        }
         while let Some(frame) = service.poll_transmit() {
             bus.send(&frame).map_err(DriveError::Io)?;
         }
@@ -169,69 +194,7 @@ where
     }
 }
 
-/// What an SDO driver call can fail with.
-#[derive(Debug)]
-pub enum Error {
-    /// The transfer failed: aborted by either side, or timed out.
-    Sdo(SdoError),
-    /// The value had the wrong length for its data type.
-    Value(od::ValueError),
-    /// The bus failed (the transfer was aborted locally).
-    Io(io::Error),
-    /// The client core refused to start a transfer.
-    Busy,
-    /// An uploaded VISIBLE_STRING holds `byte` at `offset`, outside the
-    /// visible characters 0x20 to 0x7E.
-    NotVisible {
-        /// Position in the uploaded data.
-        offset: usize,
-        /// The byte found there.
-        byte: u8,
-    },
-}
-
-impl fmt::Display for Error {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Error::Sdo(e) => e.fmt(f),
-            Error::Value(e) => write!(f, "bad value: {e}"),
-            Error::Io(e) => write!(f, "CAN bus error: {e}"),
-            Error::Busy => f.write_str("the SDO client is busy with another transfer"),
-            Error::NotVisible { offset, byte } => write!(
-                f,
-                "byte {byte:#04X} at offset {offset} is not a visible character (0x20 to 0x7E)"
-            ),
-        }
-    }
-}
-
-impl std::error::Error for Error {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            Error::Sdo(e) => Some(e),
-            Error::Io(e) => Some(e),
-            _ => None,
-        }
-    }
-}
-
-impl From<SdoError> for Error {
-    fn from(e: SdoError) -> Error {
-        Error::Sdo(e)
-    }
-}
-
-impl From<od::ValueError> for Error {
-    fn from(e: od::ValueError) -> Error {
-        Error::Value(e)
-    }
-}
-
-impl From<io::Error> for Error {
-    fn from(e: io::Error) -> Error {
-        Error::Io(e)
-    }
-}
+pub use error::Error;
 
 /// The transfer a driver call runs.
 #[derive(Debug, Clone, Copy)]
@@ -448,7 +411,9 @@ impl<B: Bus> SdoClient<B> {
         self.download_with(index, sub, data, Method::Auto)
     }
 
-    /// Writes `data` to (index, sub) with `method`.
+    /// Writes `data` to (index, sub) with `method`. Above 4 bytes (or
+    /// segmented or block for any size) the data is sent from `data` as
+    /// the transfer goes, without a copy ([`SdoClient::download_from`]).
     pub fn download_with(
         &mut self,
         index: u16,
@@ -456,8 +421,16 @@ impl<B: Bus> SdoClient<B> {
         data: &[u8],
         method: Method,
     ) -> Result<(), Error> {
-        self.transfer(index, sub, Transfer::Download(data, method))
-            .map(drop)
+        let expedited =
+            (1..=4).contains(&data.len()) && matches!(method, Method::Auto | Method::Standard);
+        if expedited {
+            return self
+                .transfer(index, sub, Transfer::Download(data, method))
+                .map(drop);
+        }
+        let mut source = data;
+        let size = Some(data.len() as u64);
+        self.download_from(index, sub, &mut source, size, method, |_| {})
     }
 
     /// Reads the value of entry `E`.

@@ -158,6 +158,16 @@ impl<B: Behaviour> Device<B> {
         &self.server.store().table
     }
 
+    /// Lets SDO downloads of strings and DOMAINs take up to `bytes` (4096
+    /// by default; a device that takes program downloads needs more). The
+    /// SDO server's own bound grows with it.
+    pub fn set_max_variable_size(&mut self, bytes: usize) {
+        self.server.store_mut().table.set_max_variable_size(bytes);
+        if self.server.config().max_download < bytes {
+            self.server.set_max_download(bytes);
+        }
+    }
+
     /// The model.
     pub fn behaviour(&self) -> &B {
         &self.server.store().behaviour

@@ -29,6 +29,7 @@ pub mod device;
 pub mod harness;
 #[cfg(feature = "seed-models")]
 pub mod models;
+pub mod program;
 pub mod store;
 
 pub use behaviour::{Behaviour, Context};

@@ -9,8 +9,10 @@ use eds2rust_runtime::od::{
 };
 use eds2rust_runtime::sdo::abort::AbortCode;
 
-/// Largest value accepted for an entry without a fixed size (strings,
-/// DOMAIN): larger downloads are refused with abort 0x06070012.
+/// Largest value accepted by default for an entry without a fixed size
+/// (strings, DOMAIN): larger downloads are refused with abort 0x06070012.
+/// [`ObjectTable::set_max_variable_size`] changes it (a device that takes
+/// program downloads, say).
 pub const MAX_VARIABLE_SIZE: usize = 4096;
 
 /// One entry: its description and current value (little-endian bus form).
@@ -31,6 +33,8 @@ struct Slot {
 #[derive(Debug, Clone)]
 pub struct ObjectTable {
     slots: BTreeMap<(u16, u8), Slot>,
+    /// Largest value of an entry without a fixed size.
+    max_variable: usize,
 }
 
 /// Why a device-side write did not take.
@@ -78,6 +82,17 @@ impl std::fmt::Display for SetError {
 impl std::error::Error for SetError {}
 
 impl ObjectTable {
+    /// Lets bus writes of entries without a fixed size (strings, DOMAIN)
+    /// take up to `bytes` ([`MAX_VARIABLE_SIZE`] by default).
+    pub fn set_max_variable_size(&mut self, bytes: usize) {
+        self.max_variable = bytes;
+    }
+
+    /// The largest value a bus write of a string or DOMAIN may have.
+    pub fn max_variable_size(&self) -> usize {
+        self.max_variable
+    }
+
     /// A table holding every entry of `objects` at its default value; the
     /// `$NODEID` defaults are resolved for `node` (entries whose default
     /// needs a node id are zero while the node is unconfigured). Entries
@@ -90,7 +105,10 @@ impl ObjectTable {
                 ((info.index, info.subindex), Slot { info: *info, value })
             })
             .collect();
-        ObjectTable { slots }
+        ObjectTable {
+            slots,
+            max_variable: MAX_VARIABLE_SIZE,
+        }
     }
 
     /// Sets every entry in `range` of indices back to its default for
@@ -229,7 +247,7 @@ impl ObjectTable {
             return Err(AbortCode::WriteReadOnly);
         }
         match size {
-            Some(size) => check_length(slot.info.data_type, size),
+            Some(size) => check_length(slot.info.data_type, size, self.max_variable),
             None => Ok(()),
         }
     }
@@ -277,12 +295,12 @@ fn default_bytes(info: &ObjectInfo, node: Option<NodeId>) -> Vec<u8> {
 }
 
 /// A download of `size` bytes into an entry of `data_type`: fixed sizes must
-/// match; variable sizes must stay under [`MAX_VARIABLE_SIZE`].
-fn check_length(data_type: DataType, size: usize) -> Result<(), AbortCode> {
+/// match; variable sizes must stay within `max_variable`.
+fn check_length(data_type: DataType, size: usize, max_variable: usize) -> Result<(), AbortCode> {
     match data_type.size() {
         Some(expected) if size > expected => Err(AbortCode::LengthTooHigh),
         Some(expected) if size < expected => Err(AbortCode::LengthTooLow),
-        None if size > MAX_VARIABLE_SIZE => Err(AbortCode::LengthTooHigh),
+        None if size > max_variable => Err(AbortCode::LengthTooHigh),
         _ => Ok(()),
     }
 }

@@ -333,7 +333,11 @@ fn an_additional_sdo_channel_with_29_bit_ids_is_served() {
     use eds2rust_runtime::sdo::client::ClientConfig;
 
     let record = |sub, name, access, default: u32| {
-        let data_type = if sub == 0 { DataType::Unsigned8 } else { DataType::Unsigned32 };
+        let data_type = if sub == 0 {
+            DataType::Unsigned8
+        } else {
+            DataType::Unsigned32
+        };
         ObjectInfo::new(0x1201, sub, name, data_type, access, false)
             .with_default(DefaultValue::Number(Number::Int(i128::from(default))))
     };
@@ -360,11 +364,16 @@ fn an_additional_sdo_channel_with_29_bit_ids_is_served() {
 
     let (request, response) = extended.cob_ids();
     assert_eq!((request, response), (0x3ABC_0605, 0x3ABC_0585));
-    b.download(node(5), 0x1201, 2, &response.to_le_bytes()).expect("0x1201.2");
-    b.download(node(5), 0x1201, 1, &request.to_le_bytes()).expect("0x1201.1");
+    b.download(node(5), 0x1201, 2, &response.to_le_bytes())
+        .expect("0x1201.2");
+    b.download(node(5), 0x1201, 1, &request.to_le_bytes())
+        .expect("0x1201.1");
     let device_type = b.upload(node(5), 0x1000, 0).expect("default channel");
     let start = b.trace.len();
-    assert_eq!(b.upload(via, 0x1000, 0).expect("29-bit channel"), device_type);
+    assert_eq!(
+        b.upload(via, 0x1000, 0).expect("29-bit channel"),
+        device_type
+    );
     let ids: Vec<CanId> = b.trace[start..].iter().map(|(_, f)| f.id()).collect();
     assert_eq!(
         ids,

@@ -7,7 +7,10 @@
 //!   with no SocketCAN, tokio or seed drivers in its dependency graph;
 //! - downstream/vendor-drive: a vendor DCF of ../shared/eds-corpus with an
 //!   overlay and rule levels (not run without ../shared: it reads the DCF);
-//! - downstream/api-lock: the listing of a generated API locked with insta.
+//! - downstream/api-lock: the listing of a generated API locked with insta;
+//! - downstream/firmware-update: a CiA 302-3 program update, a 1 MiB image
+//!   streamed by block download to the corpus bootloader slave, simulated
+//!   (not run without ../shared: it reads the DCF).
 
 use std::path::Path;
 use std::process::Command;
@@ -57,6 +60,22 @@ fn sim_device_builds_and_runs_with_a_lean_graph() {
     assert!(dir.join("Cargo.lock").is_file(), "a lock file of its own");
     let output = cargo("sim-device", &["test"]);
     assert!(output.contains("test result: ok"), "{output}");
+    assert!(!output.contains("test result: FAILED"), "{output}");
+}
+
+#[test]
+fn firmware_update_streams_a_program_to_the_corpus_bootloader() {
+    if shared_dir().is_none() {
+        not_run("downstream/firmware-update: ../shared/eds-corpus is not beside this checkout");
+        return;
+    }
+    assert!(Path::new(&workspace_root().join("downstream/firmware-update/Cargo.lock")).is_file());
+    let output = cargo("firmware-update", &["test"]);
+    assert!(
+        output.contains("a_mebibyte_program_is_streamed_confirmed_and_started ... ok")
+            || output.contains("test result: ok. 1 passed"),
+        "{output}"
+    );
     assert!(!output.contains("test result: FAILED"), "{output}");
 }
 

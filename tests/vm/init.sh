@@ -75,6 +75,8 @@ while IFS= read -r arg; do
 done </vmtest.args
 
 export RUST_BACKTRACE=1
+# The eds2rust binary the CLI's live-bus tests run (cli/tests/live_vcan.rs).
+export EDS2RUST_CLI=/cli/eds2rust
 rc=0
 ran=0
 for t in /tests/*; do

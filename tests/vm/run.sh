@@ -189,6 +189,7 @@ kernel() {
 BUILD=$VM/cargo
 TESTBIN=$VM/tests
 EXBIN=$VM/examples
+CLIBIN=$VM/cli
 build_tests() {
     say "building static test binaries"
     local json=$VM/cargo.json
@@ -206,6 +207,21 @@ build_tests() {
         -p eds2rust-tests --test vcan_python \
         --message-format=json-render-diagnostics >"$pyjson") ||
         infra "cargo build of the static python-canopen test binary failed"
+    # The CLI's live-bus commands (cli/tests/live_vcan.rs) and the eds2rust
+    # binary they run, against the seed-device simulators and a
+    # python-canopen LocalNode.
+    local clijson=$VM/cargo-cli.json
+    (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
+        CARGO_PROFILE_DEV_DEBUG=false cargo build --target "$TRIPLE" --target-dir "$BUILD" \
+        -p eds2rust-cli --bin eds2rust --test live_vcan \
+        --message-format=json-render-diagnostics >"$clijson") ||
+        infra "cargo build of the static CLI and its live-bus tests failed"
+    local cli
+    cli=$(grep '"reason":"compiler-artifact"' "$clijson" | grep '"kind":\["bin"\]' |
+        sed -n 's/.*"executable":"\([^"]*\)".*/\1/p' | head -n 1)
+    [[ -n $cli ]] || infra "cargo built no eds2rust binary"
+    file -b "$cli" | grep -q 'statically linked\|static-pie' || infra "$cli is not statically linked"
+    rm -rf "$CLIBIN" && mkdir -p "$CLIBIN" && cp "$cli" "$CLIBIN/eds2rust"
     # The seed-device examples, each run in the VM with its simulator on its
     # own vcan interface: NMT, heartbeat, SDO, PDO (and LSS) over the kernel.
     local exjson=$VM/cargo-examples.json
@@ -231,7 +247,9 @@ build_tests() {
             infra "$exe is not statically linked"
         cp "$exe" "$TESTBIN/$(basename "$exe" | sed 's/-[0-9a-f]*$//')"
         n=$((n + 1))
-    done < <(cat "$json" "$pyjson" | grep '"reason":"compiler-artifact"' | grep '"test":true' |
+    # (A binary target is marked "test":true too: only test harnesses here.)
+    done < <(cat "$json" "$pyjson" "$clijson" | grep '"reason":"compiler-artifact"' | grep '"test":true' |
+        grep -v '"kind":\["bin"\]' |
         sed -n 's/.*"executable":"\([^"]*\)".*/\1/p')
     [[ $n -gt 0 ]] || infra "cargo built no test executable"
 }
@@ -251,7 +269,7 @@ shares() {
     fi
     libdir=$(dirname "$(readlink -f /lib64/ld-linux-x86-64.so.2)")
     local dir
-    for dir in "$ROOT/tests/python" "$PYVENV" "$prefix" "$libdir"; do
+    for dir in "$ROOT/tests/python" "$ROOT/cli/tests/python" "$PYVENV" "$prefix" "$libdir"; do
         [[ -d $dir && $dir != *[[:space:]=,]* ]] || infra "cannot share $dir into the VM"
         SHARES+=("$dir")
     done
@@ -273,6 +291,7 @@ initramfs() {
     ln -s "$libdir/ld-linux-x86-64.so.2" "$dir/lib64/ld-linux-x86-64.so.2"
     cp "$TESTBIN"/* "$dir/tests/"
     mkdir -p "$dir/examples" && cp "$EXBIN"/* "$dir/examples/"
+    mkdir -p "$dir/cli" && cp "$CLIBIN"/* "$dir/cli/"
     {
         echo "VCAN_COUNT=$VCAN_COUNT"
         echo "REQUIRED_MODULES='${REQUIRED_MODULES[*]}'"

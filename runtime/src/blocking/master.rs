@@ -280,7 +280,22 @@ impl<B: Bus> Master<B> {
         deadline: Option<Instant>,
         until: &mut dyn FnMut(MasterEvent) -> Result<T, MasterEvent>,
     ) -> Result<T, DriveError> {
+        self.wait_with(deadline, until, &mut |_, _| ControlFlow::Continue(()))
+    }
+
+    /// [`Master::wait`] with `hook` run first in every round (streamed
+    /// transfers feed and take their data there); breaking from it stops
+    /// with [`DriveError::Stopped`].
+    pub(super) fn wait_with<T>(
+        &mut self,
+        deadline: Option<Instant>,
+        until: &mut dyn FnMut(MasterEvent) -> Result<T, MasterEvent>,
+        hook: &mut dyn FnMut(&mut master::Master, Instant) -> ControlFlow<()>,
+    ) -> Result<T, DriveError> {
         loop {
+            if hook(&mut self.core, self.clock.now()).is_break() {
+                return Err(DriveError::Stopped);
+            }
             self.flush().map_err(DriveError::Io)?;
             while let Some(event) = self.core.poll_event() {
                 match until(event) {

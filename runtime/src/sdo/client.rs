@@ -32,6 +32,8 @@
 
 mod block;
 mod segmented;
+mod service;
+mod stream;
 #[cfg(test)]
 mod tests;
 
@@ -40,12 +42,16 @@ use alloc::vec::Vec;
 use core::mem;
 use core::time::Duration;
 
-use super::proto::{BlockSegment, Initiate, Request, Response};
+use super::proto::{Initiate, Request, Response};
 use super::{AbortCode, Channel, DEFAULT_TIMEOUT, MAX_BLOCK_SIZE, SdoError};
-use crate::{Frame, Instant, Service};
+use crate::Instant;
+#[cfg(doc)]
+use crate::Service;
 
 use crate::queue::Ring;
 use block::{DownloadBlock, UploadBlock};
+pub use stream::WINDOW;
+use stream::{Crc16, Outgoing};
 
 /// Frames the client holds for `poll_transmit`.
 const TX_SLOTS: usize = 4;
@@ -150,8 +156,8 @@ pub enum ClientEvent {
 pub struct Progress {
     /// Bytes sent (downloads) or received (uploads) so far.
     pub done: usize,
-    /// Size of the value: always known for downloads, for uploads when the
-    /// server announced it.
+    /// Size of the value: known for downloads of a slice and streamed ones
+    /// with a size, for uploads when the server announced it.
     pub total: Option<usize>,
 }
 
@@ -166,10 +172,18 @@ enum Phase {
     },
     /// Segmented download initiate sent; segments follow its response.
     DownloadInitiate,
-    /// Download segment with `toggle` sent; `sent` bytes are out so far.
+    /// The segment at `offset` (with `toggle`) waits for the caller's data
+    /// (streamed downloads); nothing is due from the server.
+    DownloadData {
+        toggle: bool,
+        offset: usize,
+    },
+    /// Download segment with `toggle` sent; `sent` bytes are out so far,
+    /// `last` if it was the last segment.
     DownloadSegment {
         toggle: bool,
         sent: usize,
+        last: bool,
     },
     /// Upload initiate sent.
     UploadInitiate,
@@ -210,12 +224,20 @@ pub struct SdoClient {
     sub: u8,
     /// When the server's next frame is due (meaningful while not idle).
     deadline: Instant,
-    /// Download data, or upload data received so far. Its capacity stays
-    /// within `max_upload` between transfers.
+    /// Upload data received and not taken. Its capacity stays within
+    /// `max_upload` between transfers.
     buf: Vec<u8>,
+    /// The value of the running download (all of it, or a window).
+    out: Outgoing,
     /// The upload being finished came in an expedited response without
     /// size indication.
     padded: bool,
+    /// The running upload is streamed: the caller takes its data.
+    streamed_upload: bool,
+    /// Upload bytes the caller took ([`SdoClient::consume`]).
+    taken: usize,
+    /// CRC of the taken upload bytes.
+    in_crc: Crc16,
     /// Frames built and not yet taken by `poll_transmit`; a caller that
     /// drains after every input never has more than two waiting. When full
     /// (the caller stopped draining) the oldest is dropped.
@@ -233,7 +255,11 @@ impl SdoClient {
             sub: 0,
             deadline: Instant::ZERO,
             buf: Vec::new(),
+            out: Outgoing::new(),
             padded: false,
+            streamed_upload: false,
+            taken: 0,
+            in_crc: Crc16::new(),
             tx: Ring::new(),
             events: VecDeque::new(),
         }
@@ -247,7 +273,7 @@ impl SdoClient {
     /// Capacity of the transfer buffer in bytes (memory held between
     /// transfers; bounded by `max_upload` and the largest download).
     pub fn buffer_capacity(&self) -> usize {
-        self.buf.capacity()
+        self.buf.capacity() + self.out.bytes.capacity()
     }
 
     /// No transfer running.
@@ -257,17 +283,20 @@ impl SdoClient {
 
     /// How far the running transfer got; `None` while idle.
     pub fn progress(&self) -> Option<Progress> {
-        let len = self.buf.len();
+        let got = self.upload_total();
+        let fed = self.out.fed();
+        let total = self.out.len();
         let (done, total) = match self.phase {
             Phase::Idle => return None,
             Phase::ExpeditedDownload { len } => (0, Some(usize::from(len))),
-            Phase::DownloadInitiate | Phase::BlockDownloadInitiate => (0, Some(len)),
-            Phase::DownloadSegment { sent, .. } => (sent, Some(len)),
-            Phase::BlockDownload(block) => (block.bytes_sent(len), Some(len)),
-            Phase::BlockDownloadEnd => (len, Some(len)),
+            Phase::DownloadInitiate | Phase::BlockDownloadInitiate => (0, total),
+            Phase::DownloadData { offset, .. } => (offset, total),
+            Phase::DownloadSegment { sent, .. } => (sent, total),
+            Phase::BlockDownload(block) => (block.bytes_sent(fed), total),
+            Phase::BlockDownloadEnd => (fed, total),
             Phase::UploadInitiate | Phase::BlockUploadInitiate => (0, None),
-            Phase::UploadSegment { size, .. } => (len, size),
-            Phase::BlockUpload(block) | Phase::BlockUploadEnd(block) => (len, block.size()),
+            Phase::UploadSegment { size, .. } => (got, size),
+            Phase::BlockUpload(block) | Phase::BlockUploadEnd(block) => (got, block.size()),
         };
         Some(Progress { done, total })
     }
@@ -347,35 +376,14 @@ impl SdoClient {
             self.wait(now, Phase::ExpeditedDownload { len: size as u8 });
             return Ok(());
         }
-        if self.buf.try_reserve_exact(data.len()).is_err() {
+        self.out.reset(false, Some(data.len()));
+        if self.out.bytes.try_reserve_exact(data.len()).is_err() {
             self.refuse(AbortCode::OutOfMemory);
             return Ok(());
         }
-        self.buf.extend_from_slice(data);
-        let block = match method {
-            Method::Block => true,
-            Method::Auto => self
-                .config
-                .block_download_above
-                .is_some_and(|above| data.len() > above),
-            Method::Standard | Method::Segmented => false,
-        };
-        if block {
-            self.send(Request::BlockDownloadInitiate {
-                index,
-                sub,
-                crc: self.config.crc,
-                size: Some(size),
-            });
-            self.wait(now, Phase::BlockDownloadInitiate);
-        } else {
-            self.send(Request::DownloadInitiate {
-                index,
-                sub,
-                data: Initiate::Segmented { size: Some(size) },
-            });
-            self.wait(now, Phase::DownloadInitiate);
-        }
+        self.out.push(data);
+        self.out.ended = true;
+        self.initiate_download(now, index, sub, Some(size), method);
         Ok(())
     }
 
@@ -395,7 +403,11 @@ impl SdoClient {
         self.index = index;
         self.sub = sub;
         self.buf.clear();
+        self.out.reset(false, None);
         self.padded = false;
+        self.streamed_upload = false;
+        self.taken = 0;
+        self.in_crc = Crc16::new();
         Ok(())
     }
 
@@ -467,6 +479,12 @@ impl SdoClient {
         } else {
             self.buf.clear();
         }
+        let window = self.config.max_upload.max(WINDOW);
+        if self.out.bytes.capacity() > window {
+            self.out.bytes = VecDeque::new();
+        } else {
+            self.out.bytes.clear();
+        }
         self.events.push_back(event);
         Ended
     }
@@ -494,12 +512,12 @@ impl SdoClient {
                 }
             }
             (
-                Phase::DownloadSegment { toggle, sent },
+                Phase::DownloadSegment { toggle, sent, last },
                 Response::DownloadSegment { toggle: echo },
             ) => {
                 if echo != toggle {
                     Err(self.fail(AbortCode::ToggleBitNotAlternated))
-                } else if sent >= self.buf.len() {
+                } else if last {
                     Err(self.finish_download())
                 } else {
                     self.send_download_segment(now, sent, !toggle);
@@ -557,78 +575,5 @@ impl SdoClient {
             }
             _ => Err(self.fail(AbortCode::InvalidCommand)),
         };
-    }
-}
-
-impl Service for SdoClient {
-    type Event = ClientEvent;
-
-    fn handle_frame(&mut self, now: Instant, frame: &Frame) {
-        if self.is_idle() || frame.is_remote() || frame.id() != self.config.channel.response {
-            return;
-        }
-        let data = frame.data();
-        if let Phase::BlockUpload(block) = self.phase
-            && !BlockSegment::is_abort(data)
-        {
-            self.on_block_upload_segment(now, block, data);
-            return;
-        }
-        match Response::parse(data) {
-            Ok(response) => self.on_response(now, response),
-            Err(error) => {
-                // Abort as for any invalid command, and report the frame.
-                let code = error.abort_code();
-                self.send(Request::Abort {
-                    index: self.index,
-                    sub: self.sub,
-                    code,
-                });
-                let mut frame = [0u8; 8];
-                let len = data.len().min(8);
-                frame[..len].copy_from_slice(&data[..len]);
-                self.finish_failed(SdoError::BadResponse {
-                    frame,
-                    len: len as u8,
-                    error,
-                });
-            }
-        }
-    }
-
-    fn handle_timeout(&mut self, now: Instant) {
-        if let Some(deadline) = self.poll_timeout()
-            && now >= deadline
-        {
-            self.send(Request::Abort {
-                index: self.index,
-                sub: self.sub,
-                code: AbortCode::Timeout,
-            });
-            self.finish_failed(SdoError::Timeout);
-        }
-    }
-
-    fn poll_transmit(&mut self) -> Option<Frame> {
-        let data = match self.tx.pop() {
-            Some(data) => data,
-            None => self.next_block_segment()?,
-        };
-        Some(Frame::with_id(self.config.channel.request, data, 8))
-    }
-
-    fn poll_event(&mut self) -> Option<ClientEvent> {
-        self.events.pop_front()
-    }
-
-    /// The server's next frame is due then; `None` while idle and while
-    /// segments of a block download are still to be sent (the wait for the
-    /// block ack counts from the frame that started the sub-block).
-    fn poll_timeout(&self) -> Option<Instant> {
-        match self.phase {
-            Phase::Idle => None,
-            Phase::BlockDownload(block) if block.has_unsent() => None,
-            _ => Some(self.deadline),
-        }
     }
 }

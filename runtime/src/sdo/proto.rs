@@ -593,7 +593,7 @@ impl BlockSegment {
 
 /// CRC-16 of block transfers: CCITT polynomial 0x1021, initial value 0, no
 /// reflection (the "XMODEM" parameters).
-pub const CRC: crc::Crc<u16> = crc::Crc::<u16>::new(&crc::CRC_16_XMODEM);
+pub static CRC: crc::Crc<u16> = crc::Crc::<u16>::new(&crc::CRC_16_XMODEM);
 
 #[cfg(test)]
 mod tests;

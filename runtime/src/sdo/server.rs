@@ -217,6 +217,12 @@ impl<S: ObjectStore> SdoServer<S> {
         self.drop_transfer();
     }
 
+    /// Accepts downloads of up to `bytes` from now on (the configured
+    /// `max_download`).
+    pub fn set_max_download(&mut self, bytes: usize) {
+        self.config.max_download = bytes;
+    }
+
     /// Listens on `channels` as well as on the configured one (a device's
     /// additional server SDO parameters 0x1201–0x127F; build them with
     /// [`Channel::from_cob_ids`]). A running transfer on a channel no longer

@@ -2,11 +2,11 @@
 //! protocols): sub-blocks of up to 127 numbered segments, each acknowledged
 //! by the receiver, and a final CRC-16 over the whole value.
 
-use super::segmented::{copy_prefix, reserve_bounded, too_long_code};
+use super::segmented::{reserve_bounded, too_long_code};
 use super::{Ended, MAX_BLOCK_SIZE, Phase, SEGMENT_BYTES, SdoClient};
 use crate::Instant;
 use crate::sdo::AbortCode;
-use crate::sdo::proto::{BlockSegment, CRC, ParseError, Request};
+use crate::sdo::proto::{BlockSegment, ParseError, Request};
 
 /// State of a block download between the server's initiate response and the
 /// end frame.
@@ -17,7 +17,8 @@ pub(super) struct DownloadBlock {
     /// Segments the server acknowledged, over all sub-blocks.
     confirmed: usize,
     /// Segments in the current sub-block: the server's block size, or fewer
-    /// when less data is left.
+    /// when less data is left (found out when the last one is sent, for a
+    /// streamed value of unknown size).
     in_block: u8,
     /// Segments of the current sub-block handed out by `poll_transmit`.
     sent: u8,
@@ -29,7 +30,7 @@ impl DownloadBlock {
         self.sent < self.in_block
     }
 
-    /// Bytes handed out so far, for progress reports.
+    /// Bytes handed out so far (of `len` handed in), for progress reports.
     pub(super) fn bytes_sent(&self, len: usize) -> usize {
         self.confirmed
             .saturating_add(usize::from(self.sent))
@@ -113,12 +114,16 @@ impl SdoClient {
         if block_size == 0 || block_size > MAX_BLOCK_SIZE {
             return Err(self.fail(AbortCode::InvalidBlockSize));
         }
-        let total = segment_count(self.buf.len());
-        if confirmed >= total {
+        self.out
+            .release_before(confirmed.saturating_mul(SEGMENT_BYTES));
+        // The segments of the value, once its length is known.
+        let total = self.out.len().map(segment_count);
+        if self.out.ended && total.is_some_and(|total| confirmed >= total) {
+            let total = total.unwrap_or(1);
             let unused = total
                 .saturating_mul(SEGMENT_BYTES)
-                .saturating_sub(self.buf.len());
-            let crc = if crc { CRC.checksum(&self.buf) } else { 0 };
+                .saturating_sub(self.out.fed());
+            let crc = if crc { self.out.crc.value() } else { 0 };
             self.send(Request::BlockDownloadEnd {
                 unused: unused as u8,
                 crc,
@@ -126,7 +131,8 @@ impl SdoClient {
             self.wait(now, Phase::BlockDownloadEnd);
             return Ok(());
         }
-        let in_block = (total - confirmed).min(usize::from(block_size)) as u8;
+        let left = total.map_or(usize::MAX, |total| total.saturating_sub(confirmed));
+        let in_block = left.min(usize::from(block_size)) as u8;
         self.wait(
             now,
             Phase::BlockDownload(DownloadBlock {
@@ -148,16 +154,16 @@ impl SdoClient {
             return None;
         }
         let segment = block.confirmed.saturating_add(usize::from(block.sent));
-        let rest = self
-            .buf
-            .get(segment.saturating_mul(SEGMENT_BYTES)..)
-            .unwrap_or(&[]);
-        let mut data = [0u8; SEGMENT_BYTES];
-        copy_prefix(&mut data, rest);
+        // A streamed value may not have the segment's data yet.
+        let (data, _, last) = self.out.segment_at(segment.saturating_mul(SEGMENT_BYTES))?;
         block.sent += 1;
+        if last {
+            // The value ends here: so does the sub-block.
+            block.in_block = block.sent;
+        }
         let encoded = BlockSegment {
             seq: block.sent,
-            last: segment.saturating_add(1) >= segment_count(self.buf.len()),
+            last,
             data,
         }
         .encode();
@@ -254,9 +260,10 @@ impl SdoClient {
         if block.received > 0 && block.received >= limit {
             return Err(self.fail(too_long_code(block.size)));
         }
-        let take = limit.saturating_sub(self.buf.len()).min(SEGMENT_BYTES);
+        let take = limit.saturating_sub(self.upload_total()).min(SEGMENT_BYTES);
         let bytes = data.get(..take).unwrap_or(data);
-        if reserve_bounded(&mut self.buf, bytes.len(), limit).is_err() {
+        let room = limit.saturating_sub(self.taken);
+        if reserve_bounded(&mut self.buf, bytes.len(), room).is_err() {
             return Err(self.fail(AbortCode::OutOfMemory));
         }
         self.buf.extend_from_slice(bytes);
@@ -275,13 +282,18 @@ impl SdoClient {
         if block.size.is_some_and(|size| size != len) {
             return Err(self.fail(AbortCode::LengthMismatch));
         }
-        if len > self.buf.len() {
+        if len > self.upload_total() {
             // Only possible without an announced size, past `max_upload`.
             return Err(self.fail(AbortCode::OutOfMemory));
         }
-        self.buf.truncate(len);
-        if block.crc && CRC.checksum(&self.buf) != crc {
-            return Err(self.fail(AbortCode::CrcError));
+        // The bytes taken so far are final (the last segment is held back).
+        self.buf.truncate(len.saturating_sub(self.taken));
+        if block.crc {
+            let mut check = self.in_crc.clone();
+            check.update(&self.buf);
+            if check.value() != crc {
+                return Err(self.fail(AbortCode::CrcError));
+            }
         }
         self.send(Request::BlockUploadEnd);
         Err(self.finish_upload())

@@ -4,7 +4,7 @@
 use alloc::collections::TryReserveError;
 use alloc::vec::Vec;
 
-use super::{Ended, Phase, SEGMENT_BYTES, SdoClient};
+use super::{Ended, Phase, SdoClient};
 use crate::Instant;
 use crate::sdo::AbortCode;
 use crate::sdo::proto::{Initiate, Request};
@@ -20,6 +20,9 @@ impl SdoClient {
             return Ok(None);
         };
         match usize::try_from(size) {
+            // A streamed upload holds only what was not taken: nothing to
+            // reserve.
+            Ok(size) if size <= self.config.max_upload && self.streamed_upload => Ok(Some(size)),
             Ok(size)
                 if size <= self.config.max_upload && self.buf.try_reserve_exact(size).is_ok() =>
             {
@@ -33,24 +36,28 @@ impl SdoClient {
     /// `max_upload`); fails the transfer when it does not fit.
     pub(super) fn append_upload(&mut self, bytes: &[u8], size: Option<usize>) -> Result<(), Ended> {
         let limit = size.unwrap_or(self.config.max_upload);
-        if self.buf.len().saturating_add(bytes.len()) > limit {
+        if self.upload_total().saturating_add(bytes.len()) > limit {
             return Err(self.fail(too_long_code(size)));
         }
-        if reserve_bounded(&mut self.buf, bytes.len(), limit).is_err() {
+        let room = limit.saturating_sub(self.taken);
+        if reserve_bounded(&mut self.buf, bytes.len(), room).is_err() {
             return Err(self.fail(AbortCode::OutOfMemory));
         }
         self.buf.extend_from_slice(bytes);
         Ok(())
     }
 
-    /// Sends the download segment starting at byte `offset`.
+    /// Sends the download segment starting at byte `offset`, or waits for
+    /// the caller's data when a streamed download does not have it yet.
     pub(super) fn send_download_segment(&mut self, now: Instant, offset: usize, toggle: bool) {
-        let rest = self.buf.get(offset..).unwrap_or(&[]);
-        let mut data = [0u8; SEGMENT_BYTES];
-        let len = copy_prefix(&mut data, rest);
+        self.out.release_before(offset);
+        let Some((data, len, last)) = self.out.segment_at(offset) else {
+            self.phase = Phase::DownloadData { toggle, offset };
+            return;
+        };
         self.send(Request::DownloadSegment {
             toggle,
-            last: rest.len() <= SEGMENT_BYTES,
+            last,
             data,
             len: len as u8,
         });
@@ -59,6 +66,7 @@ impl SdoClient {
             Phase::DownloadSegment {
                 toggle,
                 sent: offset + len,
+                last,
             },
         );
     }
@@ -118,7 +126,7 @@ impl SdoClient {
             );
             return Ok(());
         }
-        if size.is_some_and(|size| size != self.buf.len()) {
+        if size.is_some_and(|size| size != self.upload_total()) {
             return Err(self.fail(AbortCode::LengthMismatch));
         }
         Err(self.finish_upload())
@@ -153,13 +161,4 @@ pub(super) fn reserve_bounded(
         .min(limit)
         .max(needed);
     buf.try_reserve_exact(target - buf.len())
-}
-
-/// Copies as much of `src` as fits into `dst`; returns the bytes copied.
-pub(super) fn copy_prefix(dst: &mut [u8], src: &[u8]) -> usize {
-    let len = dst.len().min(src.len());
-    for (slot, byte) in dst.iter_mut().zip(src) {
-        *slot = *byte;
-    }
-    len
 }

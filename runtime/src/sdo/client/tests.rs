@@ -4,10 +4,12 @@
 mod block;
 mod random;
 mod real_devices;
+mod stream;
 
 use super::*;
 use crate::frame::CanId;
 use crate::sdo::proto::ParseError;
+use crate::{Frame, Service};
 
 const REQUEST: u16 = 0x601;
 const RESPONSE: u16 = 0x581;

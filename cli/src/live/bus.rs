@@ -1,0 +1,102 @@
+//! The bus the live commands talk over: a SocketCAN interface (Linux), or
+//! in tests any [`Bus`] (a port of the virtual bus). It also feeds the
+//! progress bar of a running transfer: every frame a transfer sends carries
+//! up to 7 bytes of its data.
+
+use std::io;
+use std::io::IsTerminal;
+use std::time::Duration;
+
+use eds2rust_runtime::Frame;
+use eds2rust_runtime::blocking::Master;
+use eds2rust_runtime::master;
+use eds2rust_runtime::od::NodeId;
+use eds2rust_runtime::sdo::Channel;
+use eds2rust_runtime::sdo::client::ClientConfig;
+use eds2rust_runtime::transport::Bus;
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+
+use super::LiveError;
+
+/// The node id of the master's own (never started) heartbeat producer: the
+/// commands send no boot-up message and no heartbeat.
+const MASTER_NODE: NodeId = match NodeId::new(127) {
+    Some(n) => n,
+    None => panic!("127 is a node id"),
+};
+
+/// Any bus: SocketCAN, or the virtual bus in tests.
+pub struct LiveBus {
+    inner: Box<dyn Bus + Send>,
+}
+
+impl LiveBus {
+    pub fn new(inner: Box<dyn Bus + Send>) -> LiveBus {
+        LiveBus { inner }
+    }
+
+    /// Opens SocketCAN interface `iface`.
+    pub fn open(iface: &str) -> Result<LiveBus, LiveError> {
+        #[cfg(target_os = "linux")]
+        {
+            let bus = eds2rust_runtime::transport::socketcan::SocketCanBus::open(iface)
+                .map_err(|e| LiveError::Failed(e.to_string()))?;
+            Ok(LiveBus::new(Box::new(bus)))
+        }
+        #[cfg(not(target_os = "linux"))]
+        {
+            Err(LiveError::Failed(format!(
+                "cannot open CAN interface {iface:?}: SocketCAN needs Linux"
+            )))
+        }
+    }
+}
+
+impl Bus for LiveBus {
+    fn send(&mut self, frame: &Frame) -> io::Result<()> {
+        self.inner.send(frame)
+    }
+
+    fn recv(&mut self, timeout: Duration) -> io::Result<Option<Frame>> {
+        self.inner.recv(timeout)
+    }
+}
+
+/// A master on `bus` that sends nothing of its own (no boot-up, no
+/// heartbeat): only the commands' requests.
+pub fn master(bus: LiveBus) -> Master<LiveBus> {
+    Master::new(bus, master::Master::new(MASTER_NODE, Duration::ZERO))
+}
+
+/// Gives `node` an SDO client on its default channel with `timeout` per
+/// step.
+pub fn sdo_client(m: &mut Master<LiveBus>, node: NodeId, timeout: Duration) {
+    let mut config = ClientConfig::new(Channel::default_for(node));
+    config.timeout = timeout;
+    m.core_mut().add_sdo_client(node, config);
+}
+
+/// A node id 1 to 127.
+pub fn node_id(n: u8) -> Result<NodeId, LiveError> {
+    NodeId::new(n).ok_or_else(|| LiveError::Usage(format!("{n} is not a node id (1 to 127)")))
+}
+
+/// A progress bar of `len` units on stderr, hidden when stdout is not a
+/// terminal (a pipe, a file, a test).
+pub fn bar(len: u64, bytes: bool) -> ProgressBar {
+    let target = if std::io::stdout().is_terminal() {
+        ProgressDrawTarget::stderr()
+    } else {
+        ProgressDrawTarget::hidden()
+    };
+    let bar = ProgressBar::with_draw_target(Some(len), target);
+    let template = if bytes {
+        "{msg} [{bar:40}] {bytes}/{total_bytes} {bytes_per_sec} eta {eta}"
+    } else {
+        "{msg} [{bar:40}] {pos}/{len} eta {eta}"
+    };
+    if let Ok(style) = ProgressStyle::with_template(template) {
+        bar.set_style(style.progress_chars("=> "));
+    }
+    bar
+}

@@ -1,0 +1,427 @@
+//! Streamed SDO transfers of the blocking client: a download read from an
+//! [`io::Read`] (a file, a slice) and an upload written to an
+//! [`io::Write`], neither held whole in memory, with a progress callback.
+//! The core keeps a window ([`client::WINDOW`] bytes); see
+//! [`client::SdoClient::download_stream`].
+
+use core::ops::ControlFlow;
+use core::time::Duration;
+use std::format;
+use std::io::{self, Read, Write};
+use std::vec::Vec;
+
+use super::{DriveError, Error, Master, SdoClient, give_up, run, transfer_end};
+use crate::master::{self, MasterEvent};
+use crate::od::{self, Entry, NodeId};
+use crate::sdo::AbortCode;
+use crate::sdo::client::{self, ClientConfig, Method, Progress};
+use crate::transport::Bus;
+use crate::{Instant, Service};
+
+/// Bytes read from the source per call.
+const CHUNK: usize = 1024;
+
+/// What the hook of a streamed transfer found wrong with its source or sink.
+enum Stop {
+    Source(io::Error),
+    Sink(io::Error),
+}
+
+/// The data side of a streamed transfer: feeds the core from `reader`,
+/// hands what the core received to `writer`, and reports progress.
+struct Pump<'a, R, W, P> {
+    reader: Option<&'a mut R>,
+    writer: Option<&'a mut W>,
+    size: Option<usize>,
+    fed: usize,
+    done_reading: bool,
+    written: usize,
+    last: Option<Progress>,
+    progress: P,
+    stop: Option<Stop>,
+}
+
+impl<'a, R: Read, W: Write, P: FnMut(Progress)> Pump<'a, R, W, P> {
+    fn new(
+        reader: Option<&'a mut R>,
+        writer: Option<&'a mut W>,
+        size: Option<usize>,
+        progress: P,
+    ) -> Self {
+        Pump {
+            done_reading: reader.is_none(),
+            reader,
+            writer,
+            size,
+            fed: 0,
+            written: 0,
+            last: None,
+            progress,
+            stop: None,
+        }
+    }
+
+    /// One round: returns `Break` (with `self.stop` set) when the source or
+    /// the sink failed.
+    fn round(&mut self, core: &mut client::SdoClient, now: Instant) -> ControlFlow<()> {
+        if let Err(stop) = self.feed(core, now).and_then(|()| self.take(core)) {
+            self.stop = Some(stop);
+            return ControlFlow::Break(());
+        }
+        let progress = core.progress();
+        if progress.is_some() && progress != self.last {
+            self.last = progress;
+            if let Some(p) = progress {
+                (self.progress)(p);
+            }
+        }
+        ControlFlow::Continue(())
+    }
+
+    fn feed(&mut self, core: &mut client::SdoClient, now: Instant) -> Result<(), Stop> {
+        let Some(reader) = self.reader.as_deref_mut() else {
+            return Ok(());
+        };
+        let mut chunk = [0u8; CHUNK];
+        while !self.done_reading && core.wants_data() > 0 {
+            let want = core.wants_data().min(CHUNK);
+            let n = read_some(reader, &mut chunk[..want]).map_err(Stop::Source)?;
+            if n == 0 {
+                self.done_reading = true;
+                if let Some(size) = self.size.filter(|&size| self.fed < size) {
+                    return Err(Stop::Source(io::Error::new(
+                        io::ErrorKind::UnexpectedEof,
+                        format!(
+                            "the data ended after {} of the {size} bytes announced",
+                            self.fed
+                        ),
+                    )));
+                }
+                core.end_of_data(now);
+                break;
+            }
+            self.fed += core.feed(now, chunk.get(..n).unwrap_or(&chunk));
+            if let Some(size) = self.size.filter(|&size| self.fed == size) {
+                self.done_reading = true;
+                let mut probe = [0u8; 1];
+                if read_some(reader, &mut probe).map_err(Stop::Source)? > 0 {
+                    return Err(Stop::Source(io::Error::new(
+                        io::ErrorKind::InvalidInput,
+                        format!("the data is longer than the {size} bytes announced"),
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn take(&mut self, core: &mut client::SdoClient) -> Result<(), Stop> {
+        let Some(writer) = self.writer.as_deref_mut() else {
+            return Ok(());
+        };
+        let ready = core.received();
+        if ready.is_empty() {
+            return Ok(());
+        }
+        writer.write_all(ready).map_err(Stop::Sink)?;
+        let n = ready.len();
+        self.written += n;
+        core.consume(n);
+        Ok(())
+    }
+}
+
+/// `read`, retried when interrupted.
+fn read_some(reader: &mut impl Read, buf: &mut [u8]) -> io::Result<usize> {
+    loop {
+        match reader.read(buf) {
+            Err(e) if e.kind() == io::ErrorKind::Interrupted => continue,
+            other => return other,
+        }
+    }
+}
+
+/// The bound of a streamed transfer of `len` bytes (unknown: none).
+fn bound(len: Option<usize>, config: &ClientConfig) -> Option<Duration> {
+    let steps = len?.div_ceil(7).saturating_add(4);
+    Some(
+        config
+            .timeout
+            .saturating_mul(u32::try_from(steps).unwrap_or(u32::MAX)),
+    )
+}
+
+/// Starts a streamed download on `core`; returns the announced length.
+fn start_download(
+    core: &mut client::SdoClient,
+    now: Instant,
+    (index, sub): (u16, u8),
+    size: Option<u64>,
+    method: Method,
+) -> Result<Option<usize>, Error> {
+    let announced = match size.map(u32::try_from) {
+        None => None,
+        Some(Ok(size)) => Some(size),
+        Some(Err(_)) => {
+            return Err(Error::Source(io::Error::new(
+                io::ErrorKind::InvalidInput,
+                "an SDO download announces at most u32::MAX bytes",
+            )));
+        }
+    };
+    while core.poll_event().is_some() {}
+    core.download_stream(now, index, sub, announced, method)
+        .map_err(|client::Busy| Error::Busy)?;
+    Ok(announced.map(|s| s as usize))
+}
+
+/// Starts a streamed upload on `core`.
+fn start_upload(
+    core: &mut client::SdoClient,
+    now: Instant,
+    (index, sub): (u16, u8),
+    method: Method,
+) -> Result<(), Error> {
+    while core.poll_event().is_some() {}
+    core.upload_stream(now, index, sub, method)
+        .map_err(|client::Busy| Error::Busy)
+}
+
+/// The error of a streamed transfer the driver loop ended with `error`:
+/// the source's or sink's when the pump stopped it (the transfer is then
+/// aborted with 0x08000000), else what the loop says. The abort frame is
+/// left in `core` for the caller to send.
+fn stream_error<R, W, P>(
+    core: &mut client::SdoClient,
+    pump: &mut Pump<'_, R, W, P>,
+    error: DriveError,
+) -> Error {
+    let Some(stop) = pump.stop.take() else {
+        return give_up(core, error);
+    };
+    if !core.is_idle() {
+        core.abort(AbortCode::GeneralError);
+    }
+    while core.poll_event().is_some() {}
+    match stop {
+        Stop::Source(e) => Error::Source(e),
+        Stop::Sink(e) => Error::Sink(e),
+    }
+}
+
+/// Writes the rest an upload's end event carried, flushes, and reports the
+/// end; returns the bytes written in all.
+fn finish_upload<R, W: Write, P: FnMut(Progress)>(
+    pump: &mut Pump<'_, R, W, P>,
+    rest: &[u8],
+) -> Result<usize, Error> {
+    if let Some(writer) = pump.writer.as_deref_mut() {
+        writer
+            .write_all(rest)
+            .and_then(|()| writer.flush())
+            .map_err(Error::Sink)?;
+    }
+    let written = pump.written + rest.len();
+    if let Some(p) = pump.last {
+        (pump.progress)(Progress {
+            done: written,
+            total: p.total,
+        });
+    }
+    Ok(written)
+}
+
+impl<B: Bus> SdoClient<B> {
+    /// Writes the value `reader` yields to (index, sub) without holding it:
+    /// the client reads it as the transfer goes ([`client::WINDOW`] bytes
+    /// at most in memory). With `size` the initiate announces it and the
+    /// reader must yield exactly that many bytes; without, it does not
+    /// (segmented or block download without size indication, CiA 301).
+    /// `method`: [`Method::Block`] for a block download (or
+    /// [`Method::Auto`] above `block_download_above`), anything else a
+    /// segmented one. `progress` hears of every step.
+    ///
+    /// A reader that fails, ends early or yields more than `size` aborts
+    /// the transfer (0x08000000) and gives [`Error::Source`].
+    pub fn download_from(
+        &mut self,
+        index: u16,
+        sub: u8,
+        reader: &mut impl Read,
+        size: Option<u64>,
+        method: Method,
+        progress: impl FnMut(Progress),
+    ) -> Result<(), Error> {
+        let now = self.clock.now();
+        let len = start_download(&mut self.core, now, (index, sub), size, method)?;
+        let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
+        let total = bound(len, self.core.config());
+        self.run_stream(index, sub, &mut pump, now, total).map(drop)
+    }
+
+    /// Reads (index, sub) into `writer` as the data arrives, holding only
+    /// what was not written yet; returns the number of bytes. A block
+    /// upload's last segment is written once the end frame says how much of
+    /// it is data, and its CRC covers everything written: a transfer that
+    /// fails at the end (CRC, length) may have written data the caller must
+    /// discard. `max_upload` bounds the value.
+    pub fn upload_into(
+        &mut self,
+        index: u16,
+        sub: u8,
+        writer: &mut impl Write,
+        method: Method,
+        progress: impl FnMut(Progress),
+    ) -> Result<usize, Error> {
+        let now = self.clock.now();
+        start_upload(&mut self.core, now, (index, sub), method)?;
+        let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);
+        let total = bound(Some(self.core.config().max_upload), self.core.config());
+        let rest = self.run_stream(index, sub, &mut pump, now, total)?;
+        finish_upload(&mut pump, &rest)
+    }
+
+    /// [`SdoClient::download_from`] into the byte-valued entry `E` (a
+    /// DOMAIN such as program data 0x1F50, or a string): compiles only for
+    /// a writable one.
+    pub fn write_from<E>(
+        &mut self,
+        reader: &mut impl Read,
+        size: Option<u64>,
+        method: Method,
+        progress: impl FnMut(Progress),
+    ) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::ByteValue,
+    {
+        self.download_from(E::INDEX, E::SUBINDEX, reader, size, method, progress)
+    }
+
+    /// [`SdoClient::upload_into`] from the byte-valued entry `E`: compiles
+    /// only for a readable one.
+    pub fn read_into<E>(
+        &mut self,
+        writer: &mut impl Write,
+        method: Method,
+        progress: impl FnMut(Progress),
+    ) -> Result<usize, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::ByteValue,
+    {
+        self.upload_into(E::INDEX, E::SUBINDEX, writer, method, progress)
+    }
+
+    /// Drives a started streamed transfer to its end; returns the upload
+    /// data the end event carried.
+    fn run_stream<R: Read, W: Write, P: FnMut(Progress)>(
+        &mut self,
+        index: u16,
+        sub: u8,
+        pump: &mut Pump<'_, R, W, P>,
+        started: Instant,
+        bound: Option<Duration>,
+    ) -> Result<Vec<u8>, Error> {
+        let deadline = bound.map(|b| started + b);
+        let mut until = |event| transfer_end(event, index, sub);
+        let mut hook = |core: &mut client::SdoClient, now| pump.round(core, now);
+        let result = run(
+            &mut self.bus,
+            &self.clock,
+            &mut self.core,
+            &mut until,
+            deadline,
+            None,
+            &mut hook,
+        );
+        match result {
+            Ok(Ok(upload)) => Ok(upload.data),
+            Ok(Err(e)) => Err(e),
+            Err(e) => {
+                let error = stream_error(&mut self.core, pump, e);
+                while let Some(frame) = self.core.poll_transmit() {
+                    // Best effort: the abort frame of a failing bus may not go.
+                    let _ = self.bus.send(&frame);
+                }
+                Err(error)
+            }
+        }
+    }
+}
+
+impl<B: Bus> Master<B> {
+    /// [`SdoClient::download_from`] to `node` while the master keeps
+    /// running (heartbeat, PDOs, events queue up). A node without an SDO
+    /// client gets one on its default channel.
+    #[allow(clippy::too_many_arguments)]
+    pub fn download_from(
+        &mut self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        reader: &mut impl Read,
+        size: Option<u64>,
+        method: Method,
+        progress: impl FnMut(Progress),
+    ) -> Result<(), Error> {
+        let now = self.now();
+        let client = self.core_mut().sdo_or_default(node);
+        let len = start_download(client, now, (index, sub), size, method)?;
+        let total = bound(len, client.config());
+        let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
+        self.run_stream(node, (index, sub), &mut pump, now, total)
+            .map(drop)
+    }
+
+    /// [`SdoClient::upload_into`] from `node` while the master keeps
+    /// running.
+    pub fn upload_into(
+        &mut self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        writer: &mut impl Write,
+        method: Method,
+        progress: impl FnMut(Progress),
+    ) -> Result<usize, Error> {
+        let now = self.now();
+        let client = self.core_mut().sdo_or_default(node);
+        start_upload(client, now, (index, sub), method)?;
+        let total = bound(Some(client.config().max_upload), client.config());
+        let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);
+        let rest = self.run_stream(node, (index, sub), &mut pump, now, total)?;
+        finish_upload(&mut pump, &rest)
+    }
+
+    fn run_stream<R: Read, W: Write, P: FnMut(Progress)>(
+        &mut self,
+        node: NodeId,
+        (index, sub): (u16, u8),
+        pump: &mut Pump<'_, R, W, P>,
+        started: Instant,
+        bound: Option<Duration>,
+    ) -> Result<Vec<u8>, Error> {
+        let deadline = bound.map(|b| started + b);
+        let mut until = |event| match event {
+            MasterEvent::Sdo(n, e) if n == node => match transfer_end(e.clone(), index, sub) {
+                ControlFlow::Break(result) => Ok(result),
+                ControlFlow::Continue(()) => Err(MasterEvent::Sdo(n, e)),
+            },
+            other => Err(other),
+        };
+        let mut hook = |core: &mut master::Master, now| pump.round(core.sdo_or_default(node), now);
+        match self.wait_with(deadline, &mut until, &mut hook) {
+            Ok(Ok(upload)) => Ok(upload.data),
+            Ok(Err(e)) => Err(e),
+            Err(e) => {
+                let error = stream_error(self.core_mut().sdo_or_default(node), pump, e);
+                // Best effort: the abort frame of a failing bus may not go.
+                let _ = self.flush();
+                Err(error)
+            }
+        }
+    }
+}
