@@ -84,7 +84,12 @@ pub fn node_id(n: u8) -> Result<NodeId, LiveError> {
 /// A progress bar of `len` units on stderr, hidden when stdout is not a
 /// terminal (a pipe, a file, a test).
 pub fn bar(len: u64, bytes: bool) -> ProgressBar {
-    let target = if std::io::stdout().is_terminal() {
+    bar_drawn(len, bytes, std::io::stdout().is_terminal())
+}
+
+/// [`bar`], drawn on stderr only when `terminal`.
+fn bar_drawn(len: u64, bytes: bool, terminal: bool) -> ProgressBar {
+    let target = if terminal {
         ProgressDrawTarget::stderr()
     } else {
         ProgressDrawTarget::hidden()
@@ -99,4 +104,17 @@ pub fn bar(len: u64, bytes: bool) -> ProgressBar {
         bar.set_style(style.progress_chars("=> "));
     }
     bar
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Off when stdout is not a terminal, whatever stderr is. (Drawing on
+    /// a terminal needs one: indicatif hides a bar on a stderr that is not.)
+    #[test]
+    fn the_bar_is_off_when_stdout_is_not_a_terminal() {
+        assert!(bar_drawn(10, true, false).is_hidden());
+        assert!(bar_drawn(10, false, false).is_hidden());
+    }
 }
