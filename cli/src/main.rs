@@ -9,7 +9,9 @@
 //! 2 usage errors.
 #![forbid(unsafe_code)]
 
+mod decode;
 mod live;
+mod monitor;
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -124,6 +126,14 @@ enum Command {
         /// The new version: an EDS/DCF file or a YAML object table.
         new: PathBuf,
     },
+    /// Decodes a recorded CAN trace into named, typed CANopen values
+    /// (docs/decode.md): every frame, every SDO transfer, with the files of
+    /// the nodes their PDO fields by name.
+    Decode(decode::DecodeArgs),
+    /// Decodes a live SocketCAN bus as `decode` decodes a trace: the record
+    /// stream, or a table of the nodes (--table), and a chart of PDO fields
+    /// (--plot), until --duration ends or Ctrl-C.
+    Monitor(monitor::MonitorArgs),
     /// Reads and writes objects of a live node by SDO (docs/live-bus.md).
     #[command(subcommand)]
     Sdo(live::SdoCommand),
@@ -220,9 +230,13 @@ fn main() -> ExitCode {
         | Command::Generate { read, .. }
         | Command::Api { read, .. }
         | Command::Diff { read, .. } => read.options(),
-        Command::Sdo(_) | Command::Nmt(_) | Command::Scan(_) | Command::Od(_) | Command::Lss(_) => {
-            Ok(Options::default())
-        }
+        Command::Decode(_)
+        | Command::Monitor(_)
+        | Command::Sdo(_)
+        | Command::Nmt(_)
+        | Command::Scan(_)
+        | Command::Od(_)
+        | Command::Lss(_) => Ok(Options::default()),
     };
     let options = match read {
         Ok(options) => options,
@@ -232,6 +246,8 @@ fn main() -> ExitCode {
         }
     };
     match cli.command {
+        Command::Decode(args) => decode::run(args),
+        Command::Monitor(args) => monitor::run(args),
         Command::Sdo(cmd) => live::run_sdo(cmd),
         Command::Nmt(args) => live::run_nmt(args),
         Command::Scan(args) => live::run_scan(args),

@@ -234,11 +234,109 @@ pub mod cob {
     pub const fn rpdo(n: u8, node: NodeId) -> u16 {
         0x100 + 0x100 * n as u16 + node.get() as u16
     }
+
+    /// What a standard identifier is in the predefined connection set of
+    /// CiA 301 (and CiA 305 for LSS), by its function code (bits 7 to 10)
+    /// and node id (bits 0 to 6).
+    #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+    pub enum Function {
+        /// 0x000: NMT module control.
+        Nmt,
+        /// 0x080: SYNC.
+        Sync,
+        /// 0x081 to 0x0FF: EMCY of a node.
+        Emcy(NodeId),
+        /// 0x100: TIME stamp.
+        Time,
+        /// TPDO 1 to 4 of a node (0x181 to 0x4FF, every second block).
+        Tpdo(u8, NodeId),
+        /// RPDO 1 to 4 of a node (0x201 to 0x57F, every second block).
+        Rpdo(u8, NodeId),
+        /// 0x581 to 0x5FF: SDO server to client (the node's answer).
+        SdoTx(NodeId),
+        /// 0x601 to 0x67F: SDO client to server (the request to the node).
+        SdoRx(NodeId),
+        /// 0x701 to 0x77F: NMT error control (heartbeat, boot-up, node guarding).
+        ErrorControl(NodeId),
+        /// 0x7E5: LSS master to slaves.
+        LssMaster,
+        /// 0x7E4: LSS slaves to master.
+        LssSlave,
+        /// Anything else: no predefined meaning (node id 0 in a per-node
+        /// block, the restricted ranges, and the free identifiers).
+        Other,
+    }
+
+    /// The predefined meaning of standard identifier `id`.
+    pub const fn classify(id: u16) -> Function {
+        match id {
+            NMT => return Function::Nmt,
+            SYNC => return Function::Sync,
+            TIME => return Function::Time,
+            LSS_MASTER => return Function::LssMaster,
+            LSS_SLAVE => return Function::LssSlave,
+            _ => {}
+        }
+        let Some(node) = NodeId::new((id & 0x7F) as u8) else {
+            return Function::Other;
+        };
+        match id >> 7 {
+            0x1 => Function::Emcy(node),
+            code @ (0x3 | 0x5 | 0x7 | 0x9) => Function::Tpdo((code as u8 - 1) / 2, node),
+            code @ (0x4 | 0x6 | 0x8 | 0xA) => Function::Rpdo((code as u8 - 2) / 2, node),
+            0xB => Function::SdoTx(node),
+            0xC => Function::SdoRx(node),
+            0xE => Function::ErrorControl(node),
+            _ => Function::Other,
+        }
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn functions_of_the_predefined_connection_set() {
+        use cob::{Function as F, classify};
+        let n = |id| NodeId::new(id).unwrap();
+        let cases = [
+            (0x000, F::Nmt),
+            (0x080, F::Sync),
+            (0x081, F::Emcy(n(1))),
+            (0x0FF, F::Emcy(n(127))),
+            (0x100, F::Time),
+            (0x101, F::Other),
+            (0x180, F::Other),
+            (0x1A0, F::Tpdo(1, n(32))),
+            (0x220, F::Rpdo(1, n(32))),
+            (0x2A0, F::Tpdo(2, n(32))),
+            (0x4FF, F::Tpdo(4, n(127))),
+            (0x57F, F::Rpdo(4, n(127))),
+            (0x5A0, F::SdoTx(n(32))),
+            (0x620, F::SdoRx(n(32))),
+            (0x680, F::Other),
+            (0x6E0, F::Other),
+            (0x720, F::ErrorControl(n(32))),
+            (0x7E4, F::LssSlave),
+            (0x7E5, F::LssMaster),
+            (0x7FF, F::Other),
+        ];
+        for (id, function) in cases {
+            assert_eq!(classify(id), function, "{id:#05X}");
+        }
+        for node in 1..=127u8 {
+            let id = n(node);
+            for k in 1..=4 {
+                assert_eq!(classify(cob::tpdo(k, id)), F::Tpdo(k, id));
+                assert_eq!(classify(cob::rpdo(k, id)), F::Rpdo(k, id));
+            }
+            assert_eq!(classify(cob::emcy(id)), F::Emcy(id));
+            assert_eq!(classify(cob::sdo_tx(id)), F::SdoTx(id));
+            assert_eq!(classify(cob::sdo_rx(id)), F::SdoRx(id));
+            assert_eq!(classify(cob::heartbeat(id)), F::ErrorControl(id));
+        }
+    }
 
     #[test]
     fn display_is_candump_compact() {

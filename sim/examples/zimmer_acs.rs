@@ -416,4 +416,330 @@ mod tests {
             ],
         );
     }
+
+    // The trace decoded with the seed table (eds/zimmer_acs.yaml) against
+    // what the example printed.
+
+    use std::sync::Arc;
+
+    use eds2rust_decode::{Decoder, render};
+    use serde_json::Value as Json;
+
+    /// A decoder that knows node 40 by `eds/zimmer_acs.yaml`.
+    fn seed_decoder() -> Decoder {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../eds/zimmer_acs.yaml");
+        let loaded = eds2rust::input::read_device(&path, &eds2rust::input::Options::default());
+        assert!(
+            !loaded.diagnostics.has_errors(),
+            "{}",
+            loaded.diagnostics.render()
+        );
+        let mut decoder = Decoder::new();
+        decoder.add_node(NODE.get(), Arc::new(loaded.device.expect("a device")));
+        decoder
+    }
+
+    /// Every record of `trace` (one frame a line) as JSON.
+    fn decode(decoder: &mut Decoder, trace: &[String]) -> Vec<Json> {
+        let text = trace.join("\n");
+        let mut records = Vec::new();
+        let read = eds2rust_decode::decode_trace(decoder, text.as_bytes(), |r| {
+            records.push(render::json(r));
+            Ok(())
+        })
+        .expect("an in-memory trace");
+        assert_eq!(
+            (read.frames, read.bad_lines, read.skipped),
+            (trace.len(), 0, 0)
+        );
+        records
+    }
+
+    /// Every frame is a valid CANopen frame of a known kind, every PDO has
+    /// its mapping and every SDO transfer names a table entry and its value.
+    /// (The trace has no frame the decoder could not know: the master's and
+    /// the drive's boot-up are heartbeats, its PDOs are the table's TPDO1-3.)
+    fn assert_every_frame_decodes(records: &[Json]) {
+        for r in records {
+            match r.get("event") {
+                Some(event) => {
+                    assert_eq!(event, "sdo-transfer", "{r}");
+                    assert_eq!(r["result"], "ok", "{r}");
+                    assert!(r["name"].is_string() && !r["value"].is_null(), "{r}");
+                }
+                None => {
+                    assert_ne!(r["protocol"], "unknown", "{r}");
+                    let text = r["text"].as_str().expect("text");
+                    assert!(!text.contains("invalid frame"), "{r}");
+                    if r["protocol"] == "pdo" {
+                        assert!(r["fields"].as_array().is_some_and(|f| !f.is_empty()), "{r}");
+                        assert!(r.get("problem").is_none(), "{r}");
+                    }
+                    if r["protocol"] == "sdo" {
+                        assert!(r["name"].is_string(), "{r}");
+                    }
+                }
+            }
+        }
+    }
+
+    /// The texts of the records from `from` on, for failure messages.
+    fn texts(records: &[Json], from: usize) -> String {
+        let rest = records.get(from..).unwrap_or_default();
+        let lines: Vec<String> = rest
+            .iter()
+            .enumerate()
+            .map(|(i, r)| format!("{:4} {}", from + i, r["text"].as_str().unwrap_or("?")))
+            .collect();
+        lines.join("\n")
+    }
+
+    /// The first record from `from` on that `accept` takes.
+    fn find(records: &[Json], from: usize, what: &str, accept: impl Fn(&Json) -> bool) -> usize {
+        let found = records
+            .get(from..)
+            .and_then(|rest| rest.iter().position(accept));
+        match found {
+            Some(i) => from + i,
+            None => panic!(
+                "no record from {from} on is {what}:\n{}",
+                texts(records, from)
+            ),
+        }
+    }
+
+    /// The PDO field `name` of `record`.
+    fn field<'a>(record: &'a Json, name: &str) -> &'a Json {
+        record["fields"]
+            .as_array()
+            .and_then(|fields| fields.iter().find(|f| f["name"] == name))
+            .unwrap_or_else(|| panic!("no field {name} in {record}"))
+    }
+
+    /// `record` is an SDO transfer of node 40's entry `index` sub `sub`.
+    fn is_transfer(record: &Json, index: u16, sub: u8, direction: &str) -> bool {
+        record["event"] == "sdo-transfer"
+            && record["node"] == NODE.get()
+            && record["index"] == index
+            && record["subindex"] == sub
+            && record["direction"] == direction
+    }
+
+    /// The physical value and unit of a transfer (`...: 50 (0x32) = 50 mm/s`).
+    fn physical(record: &Json) -> (f64, String) {
+        let text = record["text"].as_str().expect("text");
+        let method = format!("({}): ", record["method"].as_str().expect("method"));
+        let shown = text.split_once(&method).map_or(text, |(_, v)| v);
+        let (_, value) = shown
+            .split_once(" = ")
+            .unwrap_or_else(|| panic!("no physical value in {record}"));
+        let value = value.split(';').next().unwrap_or(value);
+        let (number, unit) = value.split_once(' ').unwrap_or((value, ""));
+        let number = number
+            .parse()
+            .unwrap_or_else(|_| panic!("{number} is no number in {record}"));
+        (number, unit.to_string())
+    }
+
+    /// A `0x...` number of the printed text.
+    fn hex(text: &str) -> u16 {
+        let digits = text.trim().trim_start_matches("0x");
+        u16::from_str_radix(digits, 16).unwrap_or_else(|_| panic!("{text} is no hex number"))
+    }
+
+    /// A statusword and position the example handed to its state machine:
+    /// from a TPDO1, or from its SDO reads of 0x6041 and then 0x6064.
+    struct Seen {
+        at: usize,
+        statusword: u16,
+        /// The decoded statusword (with its CiA 402 state).
+        text: String,
+        /// The position's physical value and unit.
+        position: f64,
+        unit: String,
+    }
+
+    fn seen(records: &[Json]) -> Vec<Seen> {
+        let mut out = Vec::new();
+        let mut read = None;
+        for (at, r) in records.iter().enumerate() {
+            if r["pdo"] == "tpdo1" && r["node"] == NODE.get() {
+                let sw = field(r, "Statusword");
+                let p = field(r, "Position actual value");
+                out.push(Seen {
+                    at,
+                    statusword: sw["raw"].as_u64().expect("a statusword") as u16,
+                    text: sw["text"].as_str().expect("text").to_string(),
+                    position: p["value"].as_f64().expect("a position"),
+                    unit: p["unit"].as_str().unwrap_or_default().to_string(),
+                });
+            } else if is_transfer(r, 0x6041, 0, "upload") {
+                read = Some(r);
+            } else if is_transfer(r, 0x6064, 0, "upload")
+                && let Some(sw) = read.take()
+            {
+                let (position, unit) = physical(r);
+                out.push(Seen {
+                    at,
+                    statusword: sw["value"].as_u64().expect("a statusword") as u16,
+                    text: sw["text"].as_str().expect("text").to_string(),
+                    position,
+                    unit,
+                });
+            }
+        }
+        out
+    }
+
+    /// `text` (a decoded statusword or controlword) names CiA 402 state or
+    /// command `name` as the example printed it.
+    fn names_state(text: &str, name: &str) -> bool {
+        text.contains(&format!("state \"{}\"", name.to_lowercase()))
+    }
+
+    /// A position in µm as the example prints it (mm, three decimals).
+    fn as_mm(value: f64, unit: &str) -> String {
+        assert_eq!(unit, "µm", "positions are µm on the bus");
+        format!("{:.3}", value / 1000.0)
+    }
+
+    #[test]
+    fn the_trace_decodes_to_the_printed_values() {
+        // Slow enough that positions are printed while the carriage moves
+        // (every 100 ms of the half-second move).
+        let args = Args {
+            time_scale: 2.0,
+            ..Args::default()
+        };
+        let mut out = Vec::new();
+        let summary = run(&args, &mut out).expect("the scenario runs");
+        let text = String::from_utf8(out).expect("utf-8");
+        println!("{text}");
+        let records = decode(&mut seed_decoder(), &summary.trace);
+        assert_every_frame_decodes(&records);
+        let seen = seen(&records);
+        let seen_from = |from: usize, what: &str, accept: &dyn Fn(&Seen) -> bool| -> &Seen {
+            seen.iter()
+                .find(|s| s.at >= from && accept(s))
+                .unwrap_or_else(|| {
+                    panic!(
+                        "no statusword from {from} on {what}:\n{}",
+                        texts(&records, from)
+                    )
+                })
+        };
+        // Everything printed so far was seen by record `at`; the last
+        // statusword and position lines matched these records.
+        let mut at = 0;
+        let mut last_state = None;
+        let mut last_position = None;
+        let mut target_at = None;
+        let mut end = None;
+        let (mut states, mut positions) = (0, 0);
+        for line in text.lines() {
+            assert!(end.is_none(), "a line after the last: {line}\n{text}");
+            if let Some(rest) = line.strip_prefix("state: ") {
+                // `state: A -> B (statusword 0x....)`
+                let (_, rest) = rest.split_once(" -> ").expect("A -> B");
+                let (state, sw) = rest.split_once(" (statusword ").expect("statusword");
+                let sw = hex(sw.trim_end_matches(')'));
+                let after = last_state.map_or(at, |l: usize| at.max(l + 1));
+                let s = seen_from(after, line, &|s| s.statusword == sw);
+                assert!(names_state(&s.text, state), "{line}: {}", s.text);
+                (at, last_state) = (s.at, Some(s.at));
+                states += 1;
+            } else if let Some(rest) = line.strip_prefix("position ") {
+                // `position    0.000 mm (statusword 0x....)`
+                let (mm, sw) = rest.split_once(" mm (statusword ").expect("position");
+                let (mm, sw) = (mm.trim(), hex(sw.trim_end_matches(')')));
+                let after = last_position.map_or(at, |l: usize| at.max(l + 1));
+                let s = seen_from(after, line, &|s| {
+                    s.statusword == sw && as_mm(s.position, &s.unit) == mm
+                });
+                (at, last_position) = (s.at, Some(s.at));
+                positions += 1;
+            } else if line == format!("node {NODE}: NMT start") {
+                at = find(&records, at, line, |r| {
+                    r["protocol"] == "nmt" && r["command"] == "start" && r["target"] == NODE.get()
+                });
+            } else if let Some(rest) = line.strip_prefix("enable: ") {
+                // Announced: the writes follow, each with the state change it
+                // causes, so `at` stays.
+                let list = rest.split(" (").next().unwrap_or(rest);
+                let mut from = at;
+                for step in list.split(", ") {
+                    let (name, cw) = step.rsplit_once(' ').expect("NAME 0x..");
+                    let i = find(&records, from, step, |r| {
+                        is_transfer(r, 0x6040, 0, "download") && r["value"] == hex(cw)
+                    });
+                    let decoded = records[i]["text"].as_str().expect("text");
+                    assert!(names_state(decoded, name), "{step}: {decoded}");
+                    from = i + 1;
+                }
+            } else if let Some(rest) = line.strip_prefix("profile position: ") {
+                // `50 mm/s, 500 mm/s², target 40.000 mm`: mode 1, then the
+                // profile (written before the line), then the target
+                // (written by the move after it).
+                let parts: Vec<&str> = rest.split(", ").collect();
+                let [velocity, ramp, target] = parts[..] else {
+                    panic!("{line}")
+                };
+                let mode = find(&records, at, "modes of operation 1", |r| {
+                    is_transfer(r, 0x6060, 0, "download") && r["value"] == 1
+                });
+                let decoded = records[mode]["text"].as_str().expect("text");
+                assert!(decoded.ends_with("\"profile position\""), "{decoded}");
+                let mut from = mode + 1;
+                for (index, printed) in [(0x6081, velocity), (0x6083, ramp), (0x6084, ramp)] {
+                    let (number, unit) = printed.split_once(' ').expect("N unit");
+                    let number: f64 = number.parse().expect("a number");
+                    let i = find(&records, from, printed, |r| {
+                        is_transfer(r, index, 0, "download")
+                    });
+                    assert_eq!(physical(&records[i]), (number, unit.to_string()), "{line}");
+                    from = i + 1;
+                }
+                at = from - 1;
+                let mm = target
+                    .strip_prefix("target ")
+                    .and_then(|t| t.strip_suffix(" mm"));
+                let i = find(&records, from, target, |r| {
+                    is_transfer(r, 0x607A, 0, "download")
+                });
+                let (value, unit) = physical(&records[i]);
+                assert_eq!(Some(as_mm(value, &unit).as_str()), mm, "{line}");
+                target_at = Some(i);
+            } else if let Some(rest) = line.strip_prefix("set-point acknowledged (bit ") {
+                let bit: u32 = rest.trim_end_matches(')').parse().expect("a bit");
+                let after = at.max(target_at.expect("the target was written") + 1);
+                let s = seen_from(after, line, &|s| s.statusword & 1 << bit != 0);
+                assert!(s.text.contains("\"setpoint ack\""), "{line}: {}", s.text);
+                at = s.at;
+            } else if let Some(rest) = line.strip_prefix("target reached (bit ") {
+                // `10) at 40.000 mm, state Operation enabled`: the statusword
+                // with bit 10, then the position read by SDO at the end.
+                let (bit, rest) = rest.split_once(") at ").expect("bit");
+                let (mm, state) = rest.split_once(" mm, state ").expect("position, state");
+                let bit: u32 = bit.parse().expect("a bit");
+                let s = seen_from(at, line, &|s| s.statusword & 1 << bit != 0);
+                assert!(s.text.contains("\"target reached\""), "{line}: {}", s.text);
+                assert!(names_state(&s.text, state), "{line}: {}", s.text);
+                let last = records
+                    .iter()
+                    .rposition(|r| is_transfer(r, 0x6064, 0, "upload"))
+                    .expect("the position read at the end");
+                assert!(last > s.at, "{line}:\n{}", texts(&records, s.at));
+                let (value, unit) = physical(&records[last]);
+                assert_eq!(as_mm(value, &unit), mm, "{line}");
+                assert_eq!(f64::from(summary.position_um), value);
+                assert_eq!(summary.state.map(State::name), Some(state));
+                end = Some(last);
+            } else {
+                panic!("a line this test does not know: {line}\n{text}");
+            }
+        }
+        assert!(end.is_some(), "no final line:\n{text}");
+        assert_eq!(states, summary.states.len(), "{text}");
+        assert!(positions >= 1, "{text}");
+    }
 }

@@ -24,7 +24,9 @@ upload, download, nmt_command, remote_state, wait_heartbeat, emcy_log
 (RemoteNode: SDO client, NMT master, heartbeat and EMCY consumer);
 local_nmt, heartbeat_start, heartbeat_stop, emcy; barrier and send (marker
 frames on id 0x7FF, to order frames against commands); ping, dump_threads,
-exit (diagnostics). The network holds one node per id: a LocalNode and a
+exit (diagnostics). For recorded sessions: sdo_log_start, sdo_transfer,
+sdo_log (a RemoteNode's transfers, logged with their protocol), sync (SYNC
+producer), pdo_listen, pdo_log (every TPDO reception, decoded). The network holds one node per id: a LocalNode and a
 RemoteNode cannot share one.
 """
 
@@ -88,6 +90,13 @@ def parse_frame(text):
 
 def unhex(text):
     return binascii.unhexlify(text or "")
+
+
+def json_value(value):
+    """A decoded value as JSON takes it (bytes as hex)."""
+    if isinstance(value, (bytes, bytearray)):
+        return bytes(value).hex().upper()
+    return value
 
 
 class Peer:
@@ -378,6 +387,152 @@ class Peer:
             data = bytes(pdo_map.data)
             values = [[v.index, v.subindex, v.raw] for v in pdo_map.map]
         return {"data": data.hex().upper(), "values": values}
+
+    # Logged SDO transfers, SYNC and PDO receptions, for recorded sessions -
+
+    def op_sdo_log_start(self, cmd):
+        """From now on, logs every SDO transfer of RemoteNode `node`'s client:
+        its upload() and download() (which python-canopen's SdoVariable, and
+        so PdoMap.read, use) and the transfers of op sdo_transfer. Each is
+        logged as it ends, with its protocol, the bytes it moved and its
+        abort code, for op sdo_log."""
+        sdo = self.remote_node(cmd["node"]).sdo
+        if getattr(sdo, "eds2rust_log", None) is None:
+            sdo.eds2rust_log = []
+
+            def upload(index, subindex, sdo=sdo):
+                return self._transfer(sdo, index, subindex, upload=True)
+
+            def download(index, subindex, data, force_segment=False, sdo=sdo):
+                self._transfer(sdo, index, subindex, upload=False, data=data,
+                               force_segment=force_segment)
+            # Instance attributes: they shadow the methods for every caller.
+            sdo.upload = upload
+            sdo.download = download
+        return {}
+
+    def _transfer(self, sdo, index, sub, upload, data=b"", block=False,
+                  force_segment=False, crc=True):
+        """One SDO transfer as SdoClient.upload/download or sdo.open with
+        block_transfer do it, logged when op sdo_log_start was run. Returns
+        the value (uploads: cut to a fixed-size variable's length, as
+        SdoClient.upload does)."""
+        entry = {"index": index, "sub": sub, "upload": upload, "block": block,
+                 "segmented": False, "value": ""}
+        value = data
+        try:
+            if upload and block:
+                with sdo.open(index, sub, "rb", block_transfer=True,
+                              request_crc_support=crc) as fp:
+                    value = fp.read()
+            elif upload:
+                with sdo.open(index, sub, buffering=0) as fp:
+                    entry["segmented"] = fp.exp_data is None
+                    response_size = fp.size
+                    value = fp.read()
+            elif block:
+                with sdo.open(index, sub, "wb", size=len(data), block_transfer=True,
+                              request_crc_support=crc) as fp:
+                    fp.write(data)
+            else:
+                # python-canopen's rule (WritableStream): expedited for 1 to 4
+                # bytes unless forced.
+                entry["segmented"] = not 1 <= len(data) <= 4 or force_segment
+                with sdo.open(index, sub, "wb", buffering=7, size=len(data),
+                              force_segment=force_segment) as fp:
+                    fp.write(data)
+            entry["value"] = bytes(value).hex().upper()
+        except SdoAbortedError as exc:
+            entry["abort"] = exc.code
+            raise
+        except Exception as exc:
+            entry["error"] = "%s: %s" % (type(exc).__name__, exc)
+            raise
+        finally:
+            log = getattr(sdo, "eds2rust_log", None)
+            if log is not None:
+                log.append(entry)
+        if upload and not block:
+            var = sdo.od.get_variable(index, sub)
+            if var is not None and var.fixed_size:
+                size = len(var) // 8
+                if response_size is None or size < response_size:
+                    value = value[0:size]
+        return value
+
+    def op_sdo_transfer(self, cmd):
+        """An SDO transfer by RemoteNode `node`'s client: "upload" true or
+        false, "block" for a block transfer, "segmented" to force a
+        segmented download, "crc" (block: request CRC support, default
+        true), "value" (downloads, hex). Uploads reply the value."""
+        sdo = self.remote_node(cmd["node"]).sdo
+        sdo.RESPONSE_TIMEOUT = cmd.get("timeout", 1.0)
+        value = self._transfer(sdo, cmd["index"], cmd.get("sub", 0),
+                               upload=cmd["upload"], data=unhex(cmd.get("value")),
+                               block=cmd.get("block", False),
+                               force_segment=cmd.get("segmented", False),
+                               crc=cmd.get("crc", True))
+        return {"value": bytes(value).hex().upper()}
+
+    def op_sdo_log(self, cmd):
+        """The transfers logged since op sdo_log_start (and empties the log):
+        {"index", "sub", "upload", "block", "segmented" (a standard transfer
+        that was not expedited), "value" (hex), "abort" (when aborted)}."""
+        sdo = self.remote_node(cmd["node"]).sdo
+        log = getattr(sdo, "eds2rust_log", None)
+        if log is None:
+            raise ValueError("no SDO log for node %d (op sdo_log_start)" % cmd["node"])
+        entries = list(log)
+        del log[:len(entries)]
+        return {"log": entries}
+
+    def op_sync(self, cmd):
+        """Sends `count` SYNC messages (default 1) with python-canopen's SYNC
+        producer (network.sync.transmit)."""
+        for _ in range(cmd.get("count", 1)):
+            self.network.sync.transmit()
+        return {}
+
+    def op_pdo_listen(self, cmd):
+        """Logs every reception of RemoteNode `node`'s TPDOs (the maps read
+        with op tpdo_read): the map number, COB-ID, data and each mapped
+        variable's name, index, sub-index and raw value, decoded by
+        python-canopen when the frame came (a PdoMap callback)."""
+        remote = self.remote_node(cmd["node"])
+        if getattr(remote, "eds2rust_pdo_log", None) is None:
+            remote.eds2rust_pdo_log = []
+            remote.eds2rust_pdo_seen = threading.Condition()
+
+            def received(pdo_map, number, remote=remote):
+                fields = [[v.name, v.index, v.subindex, json_value(v.raw)]
+                          for v in pdo_map.map]
+                with remote.eds2rust_pdo_seen:
+                    remote.eds2rust_pdo_log.append({
+                        "number": number,
+                        "cob_id": pdo_map.cob_id,
+                        "data": bytes(pdo_map.data).hex().upper(),
+                        "fields": fields,
+                    })
+                    remote.eds2rust_pdo_seen.notify_all()
+            for number, pdo_map in remote.tpdo.map.items():
+                pdo_map.add_callback(
+                    lambda m, number=number: received(m, number))
+        return {}
+
+    def op_pdo_log(self, cmd):
+        """The receptions logged since op pdo_listen, after waiting up to
+        "timeout" seconds until there are at least "count"."""
+        remote = self.remote_node(cmd["node"])
+        seen = getattr(remote, "eds2rust_pdo_seen", None)
+        if seen is None:
+            raise ValueError("no PDO log for node %d (op pdo_listen)" % cmd["node"])
+        count = cmd.get("count", 0)
+        with seen:
+            if not seen.wait_for(lambda: len(remote.eds2rust_pdo_log) >= count,
+                                 cmd.get("timeout", 2.0)):
+                raise TimeoutError("%d of %d PDOs received" %
+                                   (len(remote.eds2rust_pdo_log), count))
+            return {"log": list(remote.eds2rust_pdo_log)}
 
     def run_command(self, cmd):
         reply = {"id": cmd.get("id")}

@@ -5,6 +5,7 @@
 
 pub mod peer;
 pub mod python;
+pub mod recording;
 
 use std::path::{Path, PathBuf};
 

@@ -16,7 +16,7 @@ pub mod lss;
 pub mod nmt;
 pub mod od;
 pub mod sdo;
-pub mod values;
+pub use eds2rust_decode::value as values;
 
 use std::fmt;
 use std::io::Write;

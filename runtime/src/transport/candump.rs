@@ -31,7 +31,7 @@ mod parse;
 #[cfg(test)]
 mod tests;
 
-pub use parse::{parse_frame, parse_line};
+pub use parse::{LogLineRef, parse_frame, parse_line, parse_line_ref};
 
 /// The longest line the [`Reader`] accepts, in bytes (a text-form line of an
 /// extended frame with a timestamp and a 15-character interface name is

@@ -23,6 +23,8 @@ pub mod embedded;
 pub mod fault;
 #[cfg(all(feature = "socketcan", target_os = "linux"))]
 pub mod socketcan;
+pub mod trace;
+pub mod trc;
 pub mod virtual_bus;
 pub mod wire;
 

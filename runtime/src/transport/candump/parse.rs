@@ -2,14 +2,43 @@
 //! [`Reason`], nothing panics).
 
 use core::time::Duration;
-use std::string::{String, ToString};
+use std::string::ToString;
 
 use super::{LogLine, Reason};
 use crate::{CanId, Frame};
 
+/// One candump line borrowing its interface name from the text: what
+/// [`parse_line_ref`] gives, without the allocation of a [`LogLine`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct LogLineRef<'a> {
+    /// The time in parentheses, when the line has one.
+    pub timestamp: Option<Duration>,
+    /// The interface name; empty for a compact frame alone.
+    pub interface: &'a str,
+    /// The frame.
+    pub frame: Frame,
+}
+
+impl LogLineRef<'_> {
+    /// The owned [`LogLine`] (copies the interface name).
+    pub fn to_owned_line(&self) -> LogLine {
+        LogLine {
+            timestamp: self.timestamp,
+            interface: self.interface.to_string(),
+            frame: self.frame,
+        }
+    }
+}
+
 /// Parses one line in any of the three forms (see [`super`]); `Ok(None)` for
 /// a blank line.
 pub fn parse_line(line: &str) -> Result<Option<LogLine>, Reason> {
+    parse_line_ref(line).map(|parsed| parsed.map(|l| l.to_owned_line()))
+}
+
+/// [`parse_line`] without allocating: the interface name stays a slice of
+/// `line`. Accepts and refuses exactly the same lines.
+pub fn parse_line_ref(line: &str) -> Result<Option<LogLineRef<'_>>, Reason> {
     let mut tokens = line.split_ascii_whitespace().peekable();
     let timestamp = match tokens.peek() {
         None => return Ok(None),
@@ -24,9 +53,9 @@ pub fn parse_line(line: &str) -> Result<Option<LogLine>, Reason> {
     if first.contains('#') {
         // The compact frame alone.
         let frame = parse_frame(first)?;
-        return finish(tokens, timestamp, String::new(), frame);
+        return finish(tokens, timestamp, "", frame);
     }
-    let interface = first.to_string();
+    let interface = first;
     let second = tokens.next().ok_or(Reason::Missing("frame"))?;
     if second.contains('#') {
         // The log form.
@@ -82,13 +111,13 @@ pub fn parse_line(line: &str) -> Result<Option<LogLine>, Reason> {
 fn finish<'a>(
     mut rest: impl Iterator<Item = &'a str>,
     timestamp: Option<Duration>,
-    interface: String,
+    interface: &'a str,
     frame: Frame,
-) -> Result<Option<LogLine>, Reason> {
+) -> Result<Option<LogLineRef<'a>>, Reason> {
     if rest.next().is_some() {
         return Err(Reason::Trailing);
     }
-    Ok(Some(LogLine {
+    Ok(Some(LogLineRef {
         timestamp,
         interface,
         frame,

@@ -1,7 +1,9 @@
-//! Values on the wire, by data type: decoding the bytes an SDO upload gave,
-//! printing them with unit, scale, named values and bit fields (the YAML
-//! semantic layer), parsing what the user typed into the bytes to download,
-//! and the IR values of a DCF's `ParameterValue`.
+//! Values on the wire, by data type, from the IR at run time: decoding the
+//! bytes of an SDO transfer or a PDO field, printing them with unit, scale,
+//! named values and bit fields (the YAML semantic layer), parsing what a
+//! user typed into the bytes to download, and the IR values of a DCF's
+//! `ParameterValue`. The trace decoder and the live-bus commands of the
+//! command line both use these rules.
 
 use std::fmt::Write as _;
 
@@ -236,11 +238,7 @@ fn int_text(t: DataType, v: i128) -> String {
 
 /// A float as the shortest decimal of its nine significant digits.
 fn number(v: f64) -> String {
-    if !v.is_finite() {
-        return v.to_string();
-    }
-    let rounded: f64 = format!("{v:.8e}").parse().unwrap_or(v);
-    rounded.to_string()
+    round9(v).to_string()
 }
 
 /// The physical value of `raw` (scale, offset) with the unit, if any.
@@ -253,6 +251,30 @@ fn physical(raw: i128, scale: Option<f64>, offset: Option<f64>, unit: Option<&St
         Some(u) => format!("= {} {u}", number(v)),
         None => format!("= {}", number(v)),
     }
+}
+
+/// The name the entry's value table gives `raw`, if any (a named value or
+/// range, or the table's fallback name outside its numeric range).
+pub fn named_value(semantics: &Semantics, raw: i128) -> Option<String> {
+    semantics.values.as_ref().and_then(|t| named(t, raw))
+}
+
+/// The physical value of `raw` when the entry has a scale or an offset.
+pub fn physical_value(semantics: &Semantics, raw: i128) -> Option<f64> {
+    if semantics.scale.is_none() && semantics.offset.is_none() {
+        return None;
+    }
+    let v = raw as f64 * semantics.scale.unwrap_or(1.0) + semantics.offset.unwrap_or(0.0);
+    Some(round9(v))
+}
+
+/// `v` rounded to nine significant digits: the decimal a scale factor
+/// means (503 × 0.1 is 50.3, not 50.300000000000004).
+fn round9(v: f64) -> f64 {
+    if !v.is_finite() {
+        return v;
+    }
+    format!("{v:.8e}").parse().unwrap_or(v)
 }
 
 /// The name of `raw` in a value table: a named value or range, or
