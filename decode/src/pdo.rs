@@ -209,7 +209,7 @@ impl PdoLayout {
 pub fn read_field(field: &FieldLayout, word: u64) -> Raw {
     let kind = field.data_type.and_then(DataType::value_kind);
     let signed = matches!(kind, Some(ValueKind::Integer { signed: true, .. }));
-    let bits = layout::get(word, field.offset, field.width, signed);
+    let bits = layout::field(word, field.offset, field.width, signed);
     match (kind, field.width) {
         (Some(ValueKind::Real { bits: 32 }), 32) => {
             Raw::Real(f64::from(f32::from_bits(bits as u32)))

@@ -2,7 +2,11 @@
 //! implementation for every PDO struct: the generator's default-PDO structs
 //! and `#[derive(Pdo)]` structs both expand to calls of these functions
 //! with constant offsets and widths, which the compiler folds into the
-//! shifts and masks a hand-written codec has.
+//! loads, shifts and masks a hand-written codec has: a field of 8, 16 or 32
+//! bits at a byte offset is read from its own bytes (`from_le_bytes` of
+//! them), any other from the whole data word. The decoder of recorded
+//! traces reads fields with [`field`], the same rule with offsets known at
+//! run time.
 //!
 //! The data of a PDO (at most 8 bytes) is one little-endian `u64` word:
 //! byte 0 holds bits 0 to 7. A field of `width` bits at `offset` holds the
@@ -16,21 +20,27 @@
 
 use crate::od::{DataType, PdoLengthError};
 
-/// The data of a frame as one word; it must be exactly `LEN` bytes (`LEN`
-/// at most 8, checked at compile time).
+/// The data of a frame, checked to be exactly `LEN` bytes (`LEN` at most
+/// 8, checked at compile time); [`get`] reads its fields.
 #[inline(always)]
-pub fn load<const LEN: usize>(data: &[u8]) -> Result<u64, PdoLengthError> {
+pub fn load<const LEN: usize>(data: &[u8]) -> Result<&[u8; LEN], PdoLengthError> {
     const { assert!(LEN <= 8, "a PDO has at most 8 data bytes") };
-    let Ok(bytes) = <[u8; LEN]>::try_from(data) else {
-        return Err(PdoLengthError {
+    match <&[u8; LEN]>::try_from(data) {
+        Ok(bytes) => Ok(bytes),
+        Err(_) => Err(PdoLengthError {
             expected: LEN,
             actual: data.len(),
-        });
-    };
+        }),
+    }
+}
+
+/// The data as one little-endian word (byte 0 in bits 0 to 7).
+#[inline(always)]
+pub fn word<const LEN: usize>(bytes: &[u8; LEN]) -> u64 {
     // Byte by byte with constant indices: the compiler builds the word
     // with the loads a hand-written `from_le_bytes([b[0], .., 0])` has.
     let byte = |i: usize| if i < LEN { bytes[i] } else { 0 };
-    Ok(u64::from_le_bytes([
+    u64::from_le_bytes([
         byte(0),
         byte(1),
         byte(2),
@@ -39,7 +49,26 @@ pub fn load<const LEN: usize>(data: &[u8]) -> Result<u64, PdoLengthError> {
         byte(5),
         byte(6),
         byte(7),
-    ]))
+    ])
+}
+
+/// The field of `width` bits at `offset` in the data, in the raw form
+/// `Scalar::from_raw` takes (see [`field`]). A field of 8, 16 or 32 bits at
+/// a byte offset is read from its own bytes, as a hand-written decoder
+/// reads it; any other from the whole word. Both give the same value.
+#[inline(always)]
+pub fn get<const LEN: usize>(d: &[u8; LEN], offset: u32, width: u32, signed: bool) -> u64 {
+    let i = (offset / 8) as usize;
+    let aligned = offset.is_multiple_of(8) && i + (width / 8) as usize <= LEN;
+    match (aligned, width, signed) {
+        (true, 8, false) => u64::from(d[i]),
+        (true, 8, true) => d[i] as i8 as u64,
+        (true, 16, false) => u64::from(u16::from_le_bytes([d[i], d[i + 1]])),
+        (true, 16, true) => i16::from_le_bytes([d[i], d[i + 1]]) as u64,
+        (true, 32, false) => u64::from(u32::from_le_bytes([d[i], d[i + 1], d[i + 2], d[i + 3]])),
+        (true, 32, true) => i32::from_le_bytes([d[i], d[i + 1], d[i + 2], d[i + 3]]) as u64,
+        _ => field(word(d), offset, width, signed),
+    }
 }
 
 /// The first `LEN` bytes of a word (`LEN` at most 8, checked at compile
@@ -62,10 +91,12 @@ pub const fn mask(width: u32) -> u64 {
     }
 }
 
-/// The field of `width` bits at `offset`, in the raw form `Scalar::from_raw`
-/// takes: sign-extended from `width` when `signed`.
+/// The field of `width` bits at `offset` of a PDO's data as one word, in
+/// the raw form `Scalar::from_raw` takes: sign-extended from `width` when
+/// `signed`. For a layout known only at run time; [`get`] is this with a
+/// layout the compiler knows.
 #[inline(always)]
-pub const fn get(word: u64, offset: u32, width: u32, signed: bool) -> u64 {
+pub const fn field(word: u64, offset: u32, width: u32, signed: bool) -> u64 {
     let bits = (word >> offset) & mask(width);
     if signed && width < 64 {
         let shift = 64 - width;
@@ -131,17 +162,45 @@ mod tests {
     fn fields_round_trip_at_any_offset() {
         let word = put(put(0, 0, 16, 0x1234), 16, 4, 0xFF);
         assert_eq!(word, 0x000F_1234);
-        assert_eq!(get(word, 0, 16, false), 0x1234);
-        assert_eq!(get(word, 16, 4, false), 0xF);
+        assert_eq!(field(word, 0, 16, false), 0x1234);
+        assert_eq!(field(word, 16, 4, false), 0xF);
         // Signed: sign-extended from the field's width.
-        assert_eq!(get(word, 16, 4, true) as i64, -1);
-        assert_eq!(get(put(0, 3, 64 - 3, u64::MAX), 3, 61, true) as i64, -1);
-        assert_eq!(get(u64::MAX, 0, 64, true), u64::MAX);
+        assert_eq!(field(word, 16, 4, true) as i64, -1);
+        assert_eq!(field(put(0, 3, 64 - 3, u64::MAX), 3, 61, true) as i64, -1);
+        assert_eq!(field(u64::MAX, 0, 64, true), u64::MAX);
+    }
+
+    /// `get` reads whole-byte fields from their bytes and the others from
+    /// the word: the same values as `field` for every offset and width.
+    #[test]
+    fn get_is_field_of_the_word() {
+        let bytes = [0x81, 0xF2, 0x03, 0x94, 0xA5, 0x06, 0xB7, 0xC8];
+        let data = load::<8>(&bytes).unwrap();
+        let w = u64::from_le_bytes(bytes);
+        assert_eq!(word(data), w);
+        for offset in 0..64 {
+            for width in 1..=64 - offset {
+                for signed in [false, true] {
+                    let (ours, theirs) = (
+                        get(data, offset, width, signed),
+                        field(w, offset, width, signed),
+                    );
+                    assert_eq!(
+                        ours, theirs,
+                        "offset {offset}, width {width}, signed {signed}"
+                    );
+                }
+            }
+        }
+        let short = load::<3>(&bytes[..3]).unwrap();
+        assert_eq!(word(short), 0x03_F281);
+        assert_eq!(get(short, 8, 16, true), field(0x03_F281, 8, 16, true));
+        assert_eq!(get(short, 16, 16, false), 0x03);
     }
 
     #[test]
     fn bytes_are_exactly_len() {
-        assert_eq!(load::<3>(&[1, 2, 3]), Ok(0x0003_0201));
+        assert_eq!(load::<3>(&[1, 2, 3]).map(word), Ok(0x0003_0201));
         assert_eq!(
             load::<3>(&[1, 2]),
             Err(PdoLengthError {
@@ -151,7 +210,7 @@ mod tests {
         );
         assert_eq!(store::<3>(0x0003_0201), [1, 2, 3]);
         assert_eq!(store::<8>(u64::MAX), [0xFF; 8]);
-        assert_eq!(load::<0>(&[]), Ok(0));
+        assert_eq!(load::<0>(&[]).map(word), Ok(0));
     }
 
     #[test]
