@@ -11,20 +11,17 @@
 //! binary or interpreter fails the test that needs it.
 #![cfg(target_os = "linux")]
 
+mod vcan;
+
+use vcan::{Sim, fails, iface, ok, scratch};
+
 use std::io::{BufRead, BufReader, Write};
 use std::path::PathBuf;
-use std::process::{Command, Output, Stdio};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-use std::thread::JoinHandle;
+use std::process::{Command, Stdio};
 
-use eds2rust_runtime::blocking;
 use eds2rust_runtime::lss::{BitRate, Identity};
-use eds2rust_runtime::transport::socketcan::SocketCanBus;
-use eds2rust_runtime::transport::{Bus, Clock};
-use eds2rust_runtime::{Instant, Service};
+use eds2rust_sim::DeviceConfig;
 use eds2rust_sim::models::{interroll_ec5000bi, linak_techline, zimmer_acs};
-use eds2rust_sim::{Behaviour, Device, DeviceConfig};
 use serde_json::{Value, json};
 
 /// Interface indices in `CAN_IFACES`, one per test.
@@ -39,69 +36,10 @@ const LINAK: &str = include_str!("../../eds/linak_techline.yaml");
 const INTERROLL: &str = include_str!("../../eds/interroll_ec5000bi.yaml");
 const EXAMPLE_EDS: &str = include_str!("../../eds/example.eds");
 
-fn iface(index: usize) -> String {
-    let list = std::env::var("CAN_IFACES").unwrap_or_else(|_| {
-        panic!("CAN_IFACES is not set: it must list vcan interfaces (tests/vm/run.sh does)")
-    });
-    let names: Vec<&str> = list.split([' ', ',']).filter(|s| !s.is_empty()).collect();
-    names
-        .get(index)
-        .unwrap_or_else(|| panic!("CAN_IFACES={list:?} has no entry {index}"))
-        .to_string()
-}
-
-fn cli() -> PathBuf {
-    let path = std::env::var_os("EDS2RUST_CLI")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_eds2rust")));
-    assert!(
-        path.exists(),
-        "no eds2rust binary at {} (EDS2RUST_CLI)",
-        path.display()
-    );
-    path
-}
-
-/// A scratch directory of this test (tmpfs in the VM).
-fn scratch(name: &str) -> PathBuf {
-    let dir =
-        std::env::temp_dir().join(format!("eds2rust-live-vcan-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
 fn write_file(dir: &std::path::Path, name: &str, text: &str) -> String {
     let path = dir.join(name);
     std::fs::write(&path, text).unwrap();
     path.display().to_string()
-}
-
-/// Runs the CLI; prints the command line and its output.
-fn run<S: AsRef<str>>(args: &[S]) -> Output {
-    let args: Vec<&str> = args.iter().map(AsRef::as_ref).collect();
-    let out = Command::new(cli())
-        .args(&args)
-        .output()
-        .expect("running eds2rust");
-    eprintln!("$ eds2rust {}", args.join(" "));
-    eprint!("{}", String::from_utf8_lossy(&out.stdout));
-    eprint!("{}", String::from_utf8_lossy(&out.stderr));
-    eprintln!("(exit status {:?})", out.status.code());
-    out
-}
-
-/// Runs the CLI, which must succeed; its stdout.
-fn ok<S: AsRef<str>>(args: &[S]) -> String {
-    let out = run(args);
-    assert!(out.status.success(), "eds2rust failed");
-    String::from_utf8(out.stdout).unwrap()
-}
-
-/// Runs the CLI, which must fail with `code`; its stderr.
-fn fails<S: AsRef<str>>(code: i32, args: &[S]) -> String {
-    let out = run(args);
-    assert_eq!(out.status.code(), Some(code), "the exit status of eds2rust");
-    String::from_utf8(out.stderr).unwrap()
 }
 
 /// The text of section `[name]` of an EDS/DCF, up to the next section.
@@ -114,53 +52,11 @@ fn section<'a>(text: &'a str, name: &str) -> &'a str {
     &body[..body.find("\n[").map_or(body.len(), |e| e + 1)]
 }
 
-/// A simulated device on a SocketCAN interface, in a thread.
-struct Sim {
-    stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<std::io::Result<()>>>,
-}
-
-impl Sim {
-    fn start<B>(name: &str, device: impl FnOnce(Instant) -> Device<B>) -> Sim
-    where
-        B: Behaviour + Send + 'static,
-        B::Event: Send,
-    {
-        let mut port = SocketCanBus::open(name).unwrap_or_else(|e| panic!("opening {name}: {e}"));
-        let clock = Clock::new();
-        let mut device = device(clock.now());
-        while let Some(frame) = device.poll_transmit() {
-            port.send(&frame).unwrap();
-        }
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&stop);
-        let thread = std::thread::spawn(move || {
-            blocking::serve(&mut port, &clock, &mut device, &flag, None, |_| {})
-        });
-        Sim {
-            stop,
-            thread: Some(thread),
-        }
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.thread.take() {
-            let r = t.join().expect("the simulator thread panicked");
-            if !std::thread::panicking() {
-                r.expect("the simulator's bus failed");
-            }
-        }
-    }
-}
-
 #[test]
 #[ignore = "needs vcan: tests/vm/run.sh"]
 fn sdo_read_write_typed_and_raw() {
     let i = iface(SDO);
-    let dir = scratch("sdo");
+    let dir = scratch("live-vcan", "sdo");
     let od = write_file(&dir, "zimmer_acs.yaml", ZIMMER);
     let _sim = Sim::start(&i, zimmer_acs::simulator);
     let base = ["--iface", i.as_str(), "--node", "40", "--timeout", "2s"];
@@ -238,7 +134,7 @@ fn sdo_read_write_typed_and_raw() {
 #[ignore = "needs vcan: tests/vm/run.sh"]
 fn nmt_and_scan_find_the_node_with_its_identity() {
     let i = iface(NMT_SCAN);
-    let dir = scratch("nmt");
+    let dir = scratch("live-vcan", "nmt");
     let od = write_file(&dir, "linak.yaml", LINAK);
     let _sim = Sim::start(&i, linak_techline::simulator);
     ok(&[
@@ -375,7 +271,7 @@ fn lss_fastscan_and_set_node_id() {
         format!("0x1018.4 = {0} (0x{0:08X})\n", identity.serial)
     );
     // A file into a string entry by block transfer, read back.
-    let dir = scratch("lss");
+    let dir = scratch("live-vcan", "lss");
     let od = write_file(&dir, "interroll.yaml", INTERROLL);
     let file = write_file(&dir, "catalogue.txt", "CAT-0123456789-ABCDEFGHIJ");
     let common = [
@@ -415,7 +311,7 @@ fn lss_fastscan_and_set_node_id() {
 #[ignore = "needs vcan: tests/vm/run.sh"]
 fn od_upload_then_download_restores_a_changed_value() {
     let i = iface(BACKUP);
-    let dir = scratch("backup");
+    let dir = scratch("live-vcan", "backup");
     let od = write_file(&dir, "zimmer_acs.yaml", ZIMMER);
     let dcf = dir.join("node40.dcf").display().to_string();
     let _sim = Sim::start(&i, zimmer_acs::simulator);
@@ -497,7 +393,7 @@ fn od_upload_then_download_restores_a_changed_value() {
 #[ignore = "needs vcan and python-canopen: tests/vm/run.sh"]
 fn against_a_python_canopen_local_node() {
     let i = iface(PYTHON);
-    let dir = scratch("python");
+    let dir = scratch("live-vcan", "python");
     // python-canopen reads the EDS as our exporter writes it (example.eds
     // itself lacks the DummyUsage keys python-canopen requires).
     let source = write_file(&dir, "example.eds", EXAMPLE_EDS);

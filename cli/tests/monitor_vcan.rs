@@ -11,21 +11,21 @@
 //! (default: the one cargo built). The other tests need no bus.
 #![cfg(target_os = "linux")]
 
+mod vcan;
+
+use vcan::{Sim, cli, fails, iface, ok, scratch};
+
 use std::io::{BufRead, BufReader, Read};
-use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Output, Stdio};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
 use std::sync::mpsc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use eds2rust_runtime::blocking;
+use eds2rust_runtime::transport::Bus;
 use eds2rust_runtime::transport::socketcan::SocketCanBus;
-use eds2rust_runtime::transport::{Bus, Clock};
-use eds2rust_runtime::{CanId, Frame, Instant, Service};
+use eds2rust_runtime::{CanId, Frame};
 use eds2rust_sim::models::linak_techline;
-use eds2rust_sim::{Behaviour, Device};
 use serde_json::Value;
 
 /// The index of this test's interface in `CAN_IFACES` (tests/vm/run.sh
@@ -54,66 +54,6 @@ fn expect_frame(bus: &mut SocketCanBus, id: u16, first: u8, what: &str) {
         }
     }
     panic!("no {what} (0x{id:03X} [{first:02X} ..]) within 5 s");
-}
-
-fn iface(index: usize) -> String {
-    let list = std::env::var("CAN_IFACES").unwrap_or_else(|_| {
-        panic!("CAN_IFACES is not set: it must list vcan interfaces (tests/vm/run.sh does)")
-    });
-    let names: Vec<&str> = list.split([' ', ',']).filter(|s| !s.is_empty()).collect();
-    names
-        .get(index)
-        .unwrap_or_else(|| panic!("CAN_IFACES={list:?} has no entry {index}"))
-        .to_string()
-}
-
-fn cli() -> PathBuf {
-    let path = std::env::var_os("EDS2RUST_CLI")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_BIN_EXE_eds2rust")));
-    assert!(
-        path.exists(),
-        "no eds2rust binary at {} (EDS2RUST_CLI)",
-        path.display()
-    );
-    path
-}
-
-/// A scratch directory of this test (tmpfs in the VM).
-fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!(
-        "eds2rust-monitor-vcan-{}-{name}",
-        std::process::id()
-    ));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
-
-/// Runs the CLI; prints the command line and its output.
-fn run(args: &[&str]) -> Output {
-    let out = Command::new(cli())
-        .args(args)
-        .output()
-        .expect("running eds2rust");
-    eprintln!("$ eds2rust {}", args.join(" "));
-    eprint!("{}", String::from_utf8_lossy(&out.stdout));
-    eprint!("{}", String::from_utf8_lossy(&out.stderr));
-    eprintln!("(exit status {:?})", out.status.code());
-    out
-}
-
-/// Runs the CLI, which must succeed; its stdout.
-fn ok(args: &[&str]) -> String {
-    let out = run(args);
-    assert!(out.status.success(), "eds2rust failed");
-    String::from_utf8(out.stdout).unwrap()
-}
-
-/// Runs the CLI, which must fail with `code`; its stderr.
-fn fails(code: i32, args: &[&str]) -> String {
-    let out = run(args);
-    assert_eq!(out.status.code(), Some(code), "the exit status of eds2rust");
-    String::from_utf8(out.stderr).unwrap()
 }
 
 #[test]
@@ -162,48 +102,6 @@ fn usage_errors_and_help() {
         "seconds since the monitor started",
     ] {
         assert!(help.contains(text), "no {text:?} in:\n{help}");
-    }
-}
-
-/// A simulated device on a SocketCAN interface, in a thread.
-struct Sim {
-    stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<std::io::Result<()>>>,
-}
-
-impl Sim {
-    fn start<B>(name: &str, device: impl FnOnce(Instant) -> Device<B>) -> Sim
-    where
-        B: Behaviour + Send + 'static,
-        B::Event: Send,
-    {
-        let mut port = SocketCanBus::open(name).unwrap_or_else(|e| panic!("opening {name}: {e}"));
-        let clock = Clock::new();
-        let mut device = device(clock.now());
-        while let Some(frame) = device.poll_transmit() {
-            port.send(&frame).unwrap();
-        }
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&stop);
-        let thread = std::thread::spawn(move || {
-            blocking::serve(&mut port, &clock, &mut device, &flag, None, |_| {})
-        });
-        Sim {
-            stop,
-            thread: Some(thread),
-        }
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.thread.take() {
-            let r = t.join().expect("the simulator thread panicked");
-            if !std::thread::panicking() {
-                r.expect("the simulator's bus failed");
-            }
-        }
     }
 }
 
@@ -446,7 +344,7 @@ fn check_plot(ended: &Ended, svg: &Path) {
 #[ignore = "needs vcan: tests/vm/run.sh"]
 fn monitor_streams_tables_and_plots_the_linak_actuator() {
     let i = iface(MONITOR);
-    let dir = scratch("linak");
+    let dir = scratch("monitor-vcan", "linak");
     let od = dir.join("linak_techline.yaml");
     std::fs::write(&od, LINAK).unwrap();
     let od = od.display().to_string();

@@ -303,7 +303,7 @@ fn pdo_kind(
                 l.len()
             ));
         } else {
-            let word = pdo::word(data);
+            let word = eds2rust_runtime::pdo::layout::word_of(data);
             fields.extend(l.fields.iter().map(|f| pdo::read_field(f, word)));
             if data.len() > l.len() {
                 problem = Some(format!(

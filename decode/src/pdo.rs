@@ -205,7 +205,7 @@ impl PdoLayout {
     }
 }
 
-/// The raw value of `field` in `data` (which holds at least the field's bits).
+/// The raw value of `field` in the data as one word (`layout::word_of`).
 pub fn read_field(field: &FieldLayout, word: u64) -> Raw {
     let kind = field.data_type.and_then(DataType::value_kind);
     let signed = matches!(kind, Some(ValueKind::Integer { signed: true, .. }));
@@ -221,12 +221,4 @@ pub fn read_field(field: &FieldLayout, word: u64) -> Raw {
         _ if signed => Raw::Int(i128::from(bits as i64)),
         _ => Raw::Int(i128::from(bits)),
     }
-}
-
-/// The data of a frame as one little-endian word (at most 8 bytes).
-pub fn word(data: &[u8]) -> u64 {
-    let mut bytes = [0u8; 8];
-    let n = data.len().min(8);
-    bytes[..n].copy_from_slice(&data[..n]);
-    u64::from_le_bytes(bytes)
 }

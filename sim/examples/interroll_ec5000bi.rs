@@ -334,6 +334,15 @@ fn scenario(m: &mut M, args: &Args, out: &mut dyn Write) -> Res<Summary> {
     })
 }
 
+/// Decoding the recorded trace with the seed table (the tests).
+#[cfg(test)]
+#[path = "decoded/mod.rs"]
+#[allow(
+    clippy::duplicate_mod,
+    reason = "each example is a crate of its own; the demo includes all three"
+)]
+mod decoded;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -402,97 +411,19 @@ mod tests {
     // The trace decoded with the seed table (eds/interroll_ec5000bi.yaml)
     // against what the example printed.
 
-    use std::sync::Arc;
+    use eds2rust_decode::Decoder;
 
-    use eds2rust_decode::{Decoder, render};
+    use super::decoded::{self, *};
     use serde_json::Value as Json;
 
     /// A decoder that knows the drive by `eds/interroll_ec5000bi.yaml` at
     /// both its node ids: 127 (delivery) and 5 (after LSS).
     fn seed_decoder() -> Decoder {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../eds/interroll_ec5000bi.yaml");
-        let loaded = eds2rust::input::read_device(&path, &eds2rust::input::Options::default());
-        assert!(
-            !loaded.diagnostics.has_errors(),
-            "{}",
-            loaded.diagnostics.render()
-        );
-        let device = Arc::new(loaded.device.expect("a device"));
+        let device = decoded::seed("interroll_ec5000bi");
         let mut decoder = Decoder::new();
         decoder.add_node(DEFAULT_NODE_ID, device.clone());
         decoder.add_node(NEW_NODE, device);
         decoder
-    }
-
-    /// Every record of `trace` (one frame a line) as JSON.
-    fn decode(decoder: &mut Decoder, trace: &[String]) -> Vec<Json> {
-        let text = trace.join("\n");
-        let mut records = Vec::new();
-        let read = eds2rust_decode::decode_trace(decoder, text.as_bytes(), |r| {
-            records.push(render::json(r));
-            Ok(())
-        })
-        .expect("an in-memory trace");
-        assert_eq!(
-            (read.frames, read.bad_lines, read.skipped),
-            (trace.len(), 0, 0)
-        );
-        records
-    }
-
-    /// Every frame is a valid CANopen frame of a known kind, every PDO has
-    /// its mapping and every SDO transfer names a table entry and its value.
-    /// (The trace has no frame the decoder could not know: the master's
-    /// boot-up is a heartbeat of node 1, LSS frames are LSS, the PDOs are
-    /// the table's TPDO1-3 of node 5.)
-    fn assert_every_frame_decodes(records: &[Json]) {
-        for r in records {
-            match r.get("event") {
-                Some(event) => {
-                    assert_eq!(event, "sdo-transfer", "{r}");
-                    assert_eq!(r["result"], "ok", "{r}");
-                    assert!(r["name"].is_string() && !r["value"].is_null(), "{r}");
-                }
-                None => {
-                    assert_ne!(r["protocol"], "unknown", "{r}");
-                    let text = r["text"].as_str().expect("text");
-                    assert!(!text.contains("invalid frame"), "{r}");
-                    if r["protocol"] == "pdo" {
-                        assert!(r["fields"].as_array().is_some_and(|f| !f.is_empty()), "{r}");
-                        assert!(r.get("problem").is_none(), "{r}");
-                    }
-                    if r["protocol"] == "sdo" {
-                        assert!(r["name"].is_string(), "{r}");
-                    }
-                }
-            }
-        }
-    }
-
-    /// The texts of the records from `from` on, for failure messages.
-    fn texts(records: &[Json], from: usize) -> String {
-        let rest = records.get(from..).unwrap_or_default();
-        let lines: Vec<String> = rest
-            .iter()
-            .enumerate()
-            .map(|(i, r)| format!("{:4} {}", from + i, r["text"].as_str().unwrap_or("?")))
-            .collect();
-        lines.join("\n")
-    }
-
-    /// The first record from `from` on that `accept` takes.
-    fn find(records: &[Json], from: usize, what: &str, accept: impl Fn(&Json) -> bool) -> usize {
-        let found = records
-            .get(from..)
-            .and_then(|rest| rest.iter().position(accept));
-        match found {
-            Some(i) => from + i,
-            None => panic!(
-                "no record from {from} on is {what}:\n{}",
-                texts(records, from)
-            ),
-        }
     }
 
     /// The next SDO transfer of `node`'s entry `index` sub `sub` from
@@ -513,22 +444,6 @@ mod tests {
         })
     }
 
-    /// The physical value and unit of a transfer (`...: 500 = 500 mm/s`).
-    fn physical(record: &Json) -> (f64, String) {
-        let text = record["text"].as_str().expect("text");
-        let method = format!("({}): ", record["method"].as_str().expect("method"));
-        let shown = text.split_once(&method).map_or(text, |(_, v)| v);
-        let (_, value) = shown
-            .split_once(" = ")
-            .unwrap_or_else(|| panic!("no physical value in {record}"));
-        let value = value.split(';').next().unwrap_or(value);
-        let (number, unit) = value.split_once(' ').unwrap_or((value, ""));
-        let number = number
-            .parse()
-            .unwrap_or_else(|_| panic!("{number} is no number in {record}"));
-        (number, unit.to_string())
-    }
-
     /// A printed number, decimal or `0x` hex.
     fn number(text: &str) -> u64 {
         let text = text.trim();
@@ -543,12 +458,6 @@ mod tests {
     fn quantity(text: &str) -> (f64, String) {
         let (n, unit) = text.trim().split_once(' ').expect("N unit");
         (n.parse().expect("a number"), unit.to_string())
-    }
-
-    /// `text` (a decoded statusword) names CiA 402 state `name` as the
-    /// example printed it.
-    fn names_state(text: &str, name: &str) -> bool {
-        text.contains(&format!("state \"{}\"", name.to_lowercase()))
     }
 
     #[test]

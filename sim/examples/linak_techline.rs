@@ -336,6 +336,15 @@ fn report(out: &mut dyn Write, label: &str, f: &Tpdo1Feedback) -> Result<()> {
     Ok(())
 }
 
+/// Decoding the recorded trace with the seed table (the tests).
+#[cfg(test)]
+#[path = "decoded/mod.rs"]
+#[allow(
+    clippy::duplicate_mod,
+    reason = "each example is a crate of its own; the demo includes all three"
+)]
+mod decoded;
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -413,102 +422,17 @@ mod tests {
     // The trace decoded with the seed table (eds/linak_techline.yaml)
     // against what the example printed.
 
-    use std::sync::Arc;
+    use eds2rust_decode::Decoder;
 
-    use eds2rust_decode::{Decoder, render};
+    use super::decoded::{self, *};
     use serde_json::Value as Json;
 
     /// A decoder that knows node 32 by `eds/linak_techline.yaml`.
     fn seed_decoder() -> Decoder {
-        let path =
-            std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../eds/linak_techline.yaml");
-        let loaded = eds2rust::input::read_device(&path, &eds2rust::input::Options::default());
-        assert!(
-            !loaded.diagnostics.has_errors(),
-            "{}",
-            loaded.diagnostics.render()
-        );
+        let device = decoded::seed("linak_techline");
         let mut decoder = Decoder::new();
-        decoder.add_node(NODE.get(), Arc::new(loaded.device.expect("a device")));
+        decoder.add_node(NODE.get(), device);
         decoder
-    }
-
-    /// Every record of `trace` (one frame a line) as JSON.
-    fn decode(decoder: &mut Decoder, trace: &[String]) -> Vec<Json> {
-        let text = trace.join("\n");
-        let mut records = Vec::new();
-        let read = eds2rust_decode::decode_trace(decoder, text.as_bytes(), |r| {
-            records.push(render::json(r));
-            Ok(())
-        })
-        .expect("an in-memory trace");
-        assert_eq!(
-            (read.frames, read.bad_lines, read.skipped),
-            (trace.len(), 0, 0)
-        );
-        records
-    }
-
-    /// Every frame is a valid CANopen frame of a known kind, every PDO has
-    /// its mapping and every SDO transfer names a table entry and its value.
-    /// (The trace has no frame the decoder could not know: the master's
-    /// heartbeat and boot-up are heartbeats of node 1, RPDO1 and TPDO1 are
-    /// the table's.)
-    fn assert_every_frame_decodes(records: &[Json]) {
-        for r in records {
-            match r.get("event") {
-                Some(event) => {
-                    assert_eq!(event, "sdo-transfer", "{r}");
-                    assert_eq!(r["result"], "ok", "{r}");
-                    assert!(r["name"].is_string() && !r["value"].is_null(), "{r}");
-                }
-                None => {
-                    assert_ne!(r["protocol"], "unknown", "{r}");
-                    let text = r["text"].as_str().expect("text");
-                    assert!(!text.contains("invalid frame"), "{r}");
-                    if r["protocol"] == "pdo" {
-                        assert!(r["fields"].as_array().is_some_and(|f| !f.is_empty()), "{r}");
-                        assert!(r.get("problem").is_none(), "{r}");
-                    }
-                    if r["protocol"] == "sdo" {
-                        assert!(r["name"].is_string(), "{r}");
-                    }
-                }
-            }
-        }
-    }
-
-    /// The texts of the records from `from` on, for failure messages.
-    fn texts(records: &[Json], from: usize) -> String {
-        let rest = records.get(from..).unwrap_or_default();
-        let lines: Vec<String> = rest
-            .iter()
-            .enumerate()
-            .map(|(i, r)| format!("{:4} {}", from + i, r["text"].as_str().unwrap_or("?")))
-            .collect();
-        lines.join("\n")
-    }
-
-    /// The first record from `from` on that `accept` takes.
-    fn find(records: &[Json], from: usize, what: &str, accept: impl Fn(&Json) -> bool) -> usize {
-        let found = records
-            .get(from..)
-            .and_then(|rest| rest.iter().position(accept));
-        match found {
-            Some(i) => from + i,
-            None => panic!(
-                "no record from {from} on is {what}:\n{}",
-                texts(records, from)
-            ),
-        }
-    }
-
-    /// The PDO field `name` of `record`.
-    fn field<'a>(record: &'a Json, name: &str) -> &'a Json {
-        record["fields"]
-            .as_array()
-            .and_then(|fields| fields.iter().find(|f| f["name"] == name))
-            .unwrap_or_else(|| panic!("no field {name} in {record}"))
     }
 
     fn is_pdo(record: &Json, pdo: &str) -> bool {

@@ -52,6 +52,16 @@ pub fn word<const LEN: usize>(bytes: &[u8; LEN]) -> u64 {
     ])
 }
 
+/// The data of a frame of any length as one little-endian word (its first
+/// 8 bytes; missing bytes read as zero), for layouts known only at run
+/// time ([`field`]).
+pub fn word_of(data: &[u8]) -> u64 {
+    let mut bytes = [0u8; 8];
+    let n = data.len().min(8);
+    bytes[..n].copy_from_slice(&data[..n]);
+    u64::from_le_bytes(bytes)
+}
+
 /// The field of `width` bits at `offset` in the data, in the raw form
 /// `Scalar::from_raw` takes (see [`field`]). A field of 8, 16 or 32 bits at
 /// a byte offset is read from its own bytes, as a hand-written decoder
@@ -178,6 +188,8 @@ mod tests {
         let data = load::<8>(&bytes).unwrap();
         let w = u64::from_le_bytes(bytes);
         assert_eq!(word(data), w);
+        assert_eq!(word_of(&bytes), w);
+        assert_eq!(word_of(&bytes[..3]), 0x03_F281);
         for offset in 0..64 {
             for width in 1..=64 - offset {
                 for signed in [false, true] {

@@ -229,37 +229,44 @@ impl<R: BufRead> Reader<R> {
     }
 
     /// Reads the next line into `buf`; `false` at the end of the input.
-    /// A line longer than the limit is consumed and left out of `buf`
-    /// (which then holds more than [`MAX_LINE_LEN`] bytes).
     fn read_line(&mut self) -> io::Result<bool> {
-        self.buf.clear();
-        let limit = MAX_LINE_LEN as u64 + 2; // room for "\r\n"
-        let n = Read::take(&mut self.input, limit).read_until(b'\n', &mut self.buf)?;
-        if n == 0 {
-            return Ok(false);
-        }
-        self.line += 1;
-        if self.buf.last() != Some(&b'\n') && self.buf.len() as u64 == limit {
-            // Too long: skip the rest of the line without storing it.
-            loop {
-                let available = self.input.fill_buf()?;
-                if available.is_empty() {
+        let more = read_bounded_line(&mut self.input, &mut self.buf)?;
+        self.line += usize::from(more);
+        Ok(more)
+    }
+}
+
+/// Reads the next line of `input` into `buf` (cleared first); `false` at
+/// the end of the input. A line longer than [`MAX_LINE_LEN`] bytes (plus
+/// its line end) is consumed but only its start is kept: `buf` then holds
+/// more than [`MAX_LINE_LEN`] bytes, and nothing more is stored.
+pub(super) fn read_bounded_line<R: BufRead>(input: &mut R, buf: &mut Vec<u8>) -> io::Result<bool> {
+    buf.clear();
+    let limit = MAX_LINE_LEN as u64 + 2; // room for "\r\n"
+    let n = Read::take(&mut *input, limit).read_until(b'\n', buf)?;
+    if n == 0 {
+        return Ok(false);
+    }
+    if buf.last() != Some(&b'\n') && buf.len() as u64 == limit {
+        // Too long: skip the rest of the line without storing it.
+        loop {
+            let available = input.fill_buf()?;
+            if available.is_empty() {
+                break;
+            }
+            match available.iter().position(|&b| b == b'\n') {
+                Some(pos) => {
+                    input.consume(pos + 1);
                     break;
                 }
-                match available.iter().position(|&b| b == b'\n') {
-                    Some(pos) => {
-                        self.input.consume(pos + 1);
-                        break;
-                    }
-                    None => {
-                        let len = available.len();
-                        self.input.consume(len);
-                    }
+                None => {
+                    let len = available.len();
+                    input.consume(len);
                 }
             }
         }
-        Ok(true)
     }
+    Ok(true)
 }
 
 impl<R: BufRead> Iterator for Reader<R> {

@@ -34,7 +34,7 @@
 use core::fmt;
 use core::time::Duration;
 use std::format;
-use std::io::{self, BufRead, Read};
+use std::io::{self, BufRead};
 use std::string::{String, ToString};
 use std::vec::Vec;
 
@@ -146,37 +146,12 @@ impl<R: BufRead> Reader<R> {
         self.input
     }
 
-    /// Reads the next line into `buf`; `false` at the end of the input.
-    /// A line longer than the limit is consumed but only its start is kept
-    /// (`buf` then holds more than [`MAX_LINE_LEN`] bytes).
+    /// Reads the next line into `buf`; `false` at the end of the input
+    /// (the candump reader's rule for over-long lines).
     fn read_line(&mut self) -> io::Result<bool> {
-        self.buf.clear();
-        let limit = MAX_LINE_LEN as u64 + 2; // room for "\r\n"
-        let n = Read::take(&mut self.input, limit).read_until(b'\n', &mut self.buf)?;
-        if n == 0 {
-            return Ok(false);
-        }
-        self.line += 1;
-        if self.buf.last() != Some(&b'\n') && self.buf.len() as u64 == limit {
-            // Too long: skip the rest of the line without storing it.
-            loop {
-                let available = self.input.fill_buf()?;
-                if available.is_empty() {
-                    break;
-                }
-                match available.iter().position(|&b| b == b'\n') {
-                    Some(pos) => {
-                        self.input.consume(pos + 1);
-                        break;
-                    }
-                    None => {
-                        let len = available.len();
-                        self.input.consume(len);
-                    }
-                }
-            }
-        }
-        Ok(true)
+        let more = candump::read_bounded_line(&mut self.input, &mut self.buf)?;
+        self.line += usize::from(more);
+        Ok(more)
     }
 }
 
