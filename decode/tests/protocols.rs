@@ -138,16 +138,28 @@ fn arbitrary_frames_never_panic() {
         state ^= state << 17;
         state
     };
-    let ids = [0x000, 0x080, 0x0A0, 0x100, 0x1A0, 0x220, 0x2A8, 0x5A0, 0x620, 0x5A8, 0x628, 0x720, 0x7E4, 0x7E5];
+    let ids = [
+        0x000, 0x080, 0x0A0, 0x100, 0x1A0, 0x220, 0x2A8, 0x5A0, 0x620, 0x5A8, 0x628, 0x720, 0x7E4,
+        0x7E5,
+    ];
     let mut out = Vec::new();
     for i in 0..200_000 {
         let r = next();
         let len = (r % 9) as usize;
         let bytes = next().to_le_bytes();
         let frame = match r >> 60 {
-            0 => Frame::remote(CanId::Standard(ids[(r >> 8) as usize % ids.len()]), len as u8),
-            1 => Frame::new(CanId::Extended((r >> 16) as u32 & 0x1FFF_FFFF), &bytes[..len]),
-            _ => Frame::new(CanId::Standard(ids[(r >> 8) as usize % ids.len()]), &bytes[..len]),
+            0 => Frame::remote(
+                CanId::Standard(ids[(r >> 8) as usize % ids.len()]),
+                len as u8,
+            ),
+            1 => Frame::new(
+                CanId::Extended((r >> 16) as u32 & 0x1FFF_FFFF),
+                &bytes[..len],
+            ),
+            _ => Frame::new(
+                CanId::Standard(ids[(r >> 8) as usize % ids.len()]),
+                &bytes[..len],
+            ),
         }
         .expect("a frame");
         out.clear();
