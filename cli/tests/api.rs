@@ -34,7 +34,7 @@ fn api_lists_the_generated_api_or_errors() {
         .zip(after.lines())
         .filter(|(a, b)| a != b)
         .collect();
-    let line = "od::ModesOfOperation\t0x6060\ti8\t";
+    let line = "od::ModesOfOperation\t0x6060\tod::ModesOfOperationValue\t";
     assert_eq!(
         changed,
         [(&*format!("{line}rw\t-\tpdo"), &*format!("{line}ro\t-\tpdo"))]

@@ -27,7 +27,7 @@ pub mod eds;
 pub mod r#gen;
 pub mod input;
 pub mod ir;
-pub(crate) mod profiles;
+pub mod profiles;
 pub mod read;
 pub mod table;
 

@@ -82,10 +82,14 @@ impl Loaded {
         self
     }
 
-    /// Applies the levels (the file's own, then the caller's on top) and
-    /// `strict` to the diagnostics, and sorts them: the last step of every
-    /// public reader.
+    /// Fills in the built-in meanings of the standard objects
+    /// (`profiles::apply`), applies the levels (the file's own, then the
+    /// caller's on top) and `strict` to the diagnostics, and sorts them:
+    /// the last step of every public reader.
     pub(crate) fn finish(mut self, options: &Options) -> Loaded {
+        if let Some(device) = &mut self.device {
+            crate::profiles::apply(device);
+        }
         let levels = self.levels.merged(&options.levels);
         self.diagnostics.apply_levels(&levels, options.strict);
         self.diagnostics.sort();

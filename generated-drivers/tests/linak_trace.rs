@@ -34,7 +34,7 @@ fn cob_ids_of_node_32_are_the_traces() {
     assert_eq!(pdo::Rpdo1Command::can_id(node32()), 0x220);
     assert_eq!(linak::DEFAULT_BIT_RATE_KBIT, 250);
     // $NODEID-relative defaults of other entries: EMCY and the SDO server.
-    assert_eq!(od::CobIdEmcy::default_for(node32()), 0xA0);
+    assert_eq!(od::CobIdEmcy::default_for(node32()).to_raw(), 0xA0);
     assert_eq!(
         od::sdo_server_parameter::CobIdClientToServer::default_for(node32()),
         0x620

@@ -87,11 +87,15 @@ pdo_properties! {
 fn signed_fields_are_sign_extended_and_gaps_skipped() {
     let frame = [0x37, 0x06, 0xAA, 0xFE, 0xFF, 0xFF, 0xFF];
     let tpdo = example::pdo::Tpdo1::decode(&frame).expect("7 bytes");
-    assert_eq!(tpdo.statusword, 0x0637);
+    assert_eq!(tpdo.statusword.to_raw(), 0x0637);
+    // The built-in CiA 402 meaning: the runtime's statusword, the same bits.
+    let state = eds2rust_runtime::cia402::Statusword::from(tpdo.statusword).state();
+    assert_eq!(state, Some(eds2rust_runtime::cia402::State::OperationEnabled));
+    assert!(tpdo.statusword.is_operation_enabled());
     assert_eq!(tpdo.position_actual_value, -2);
     assert_eq!(tpdo.encode(), [0x37, 0x06, 0x00, 0xFE, 0xFF, 0xFF, 0xFF]);
     let max = example::pdo::Tpdo1 {
-        statusword: 0xFFFF,
+        statusword: example::od::StatuswordValue::from_raw(0xFFFF),
         position_actual_value: i32::MIN,
     };
     assert_eq!(example::pdo::Tpdo1::decode(&max.encode()), Ok(max));
@@ -102,6 +106,7 @@ proptest! {
     /// Values with gaps in the layout: decode(encode(v)) == v for any v.
     #[test]
     fn example_values_round_trip(statusword in any::<u16>(), position in any::<i32>()) {
+        let statusword = example::od::StatuswordValue::from_raw(statusword);
         let v = example::pdo::Tpdo1 { statusword, position_actual_value: position };
         prop_assert_eq!(example::pdo::Tpdo1::decode(&v.encode()), Ok(v));
     }

@@ -157,7 +157,7 @@ fn object_table_fills_an_sdo_store() {
         .unwrap();
     });
     let mut client = SdoClient::new(bus.attach(), ClientConfig::new(Channel::default_for(node)));
-    assert_eq!(client.read::<od::CobIdEmcy>().unwrap(), 0xA0);
+    assert_eq!(client.read::<od::CobIdEmcy>().unwrap().to_raw(), 0xA0);
     assert_eq!(
         client
             .read::<od::sdo_server_parameter::CobIdClientToServer>()

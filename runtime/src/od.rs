@@ -15,6 +15,7 @@ use core::fmt;
 
 mod array;
 mod info;
+pub mod standard;
 
 pub use array::{Array, Element, Elements, array_subindex};
 pub use info::{DefaultValue, Number, ObjectInfo};

@@ -55,7 +55,7 @@ const ROUND_TRIP_RULES: &[(&str, &str)] = &[
     ),
     (
         "not-in-eds",
-        "the semantic layer, network defaults and LSS details, PDO labels, error tables and variants are not carried by CiA 306 (docs/yaml-tables.md)",
+        "the semantic layer, network defaults and LSS details, PDO labels, error tables and variants are not carried by CiA 306 (docs/yaml-tables.md); reading back derives only the built-in meanings of the standard objects again, which are set aside on both sides",
     ),
     (
         "baud-rate-without-key",
@@ -248,6 +248,9 @@ fn round_trip(devices: &[(String, Device)]) -> RoundTrip {
     for (name, original) in devices {
         let expected = expected_after_export(original, &mut tally);
         let (mut back, diagnostics) = read_export(name, &to_eds(original));
+        for entry in back.objects.values_mut().flat_map(|o| o.entries.values_mut()) {
+            entry.semantics = Default::default();
+        }
         tally
             .readback_codes
             .insert(name.clone(), codes(&diagnostics));

@@ -422,13 +422,15 @@ fn generated_code_compiles_under_clippy() {
         largest.1,
         largest.0,
     );
-    // A generated file is read in review: arrays are one indexed type and
-    // OBJECTS one line per entry, so no input comes near this (the largest
-    // corpus file gives about 19,100 lines; it gave 66,000 with a type per
-    // array element).
+    // A generated file is read in review: arrays are one indexed type,
+    // OBJECTS one line per entry and the PDO parameters' standard value
+    // types the runtime's, so no input comes near this (the largest corpus
+    // file gives about 20,100 lines, 1,000 of them the built-in meanings of
+    // ten CiA 301 objects; it gave 66,000 with a type per array element and
+    // 30,000 with generated types for the 32 PDOs' parameters).
     assert!(
-        largest.0 < 20_000,
-        "{} generates {} lines; a generated file should stay under 20,000",
+        largest.0 < 22_000,
+        "{} generates {} lines; a generated file should stay under 22,000",
         largest.1,
         largest.0
     );

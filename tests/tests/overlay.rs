@@ -107,7 +107,10 @@ fn overlay_stages_take_effect_and_leave_the_rest_alone() {
         let homing = values.named.iter().find(|n| n.low == 6).unwrap();
         assert_eq!(homing.name, "homing");
     }
-    assert!(entry(&base, 0x6041, 0).semantics.is_empty());
+    // The base EDS has the built-in CiA 402 meaning only.
+    let base_status = &entry(&base, 0x6041, 0).semantics;
+    assert!(!base_status.bits.is_empty());
+    assert!(base_status.bits.iter().all(|b| b.origin.file == "CiA 402"));
     // PDO defaults: TPDO2 named, event timer set, mapping kept
     let label = &overlay.pdo_labels[0];
     assert_eq!(

@@ -368,8 +368,12 @@ fn od_upload_then_download_restores_a_changed_value() {
     };
     let (out, r) = run(|o| backup::download(|| Ok(sim.bus()), &down, o));
     r.unwrap();
-    // (A DCF has no named values: the YAML's semantic layer stays behind.)
-    assert!(out.contains("0x6060 Modes of operation: ok 1\n"), "{out}");
+    // A DCF has no named values: the YAML's semantic layer stays behind,
+    // but the built-in CiA 402 meaning of 0x6060 is there again.
+    assert!(
+        out.contains("0x6060 Modes of operation: ok 1 \"profile position\"\n"),
+        "{out}"
+    );
     assert!(
         out.contains("0x1A00.1 TPDO1 mapping parameter.Mapped object 1: ok "),
         "{out}"

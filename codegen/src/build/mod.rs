@@ -230,6 +230,9 @@ fn load(input: &Path, overlays: &[PathBuf]) -> LoadedDevice {
     {
         diagnostics.retain(|d| !fixed_by_overlay(d, device));
     }
+    if let Some(device) = &mut device {
+        crate::profiles::apply(device);
+    }
     LoadedDevice {
         device,
         diagnostics,

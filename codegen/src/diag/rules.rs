@@ -155,6 +155,10 @@ pub const RULES: &[Rule] = &[
         "table::bad-index",
         "an index or sub-index that cannot be used",
     ),
+    rule(
+        "table::bad-profiles",
+        "a `profiles:` value other than `none` or `builtin`",
+    ),
     rule("table::bad-range", "a bit range that does not fit"),
     rule("table::bad-scale", "a scale factor that cannot be used"),
     rule("table::bad-type", "a data type name that is not known"),

@@ -20,6 +20,25 @@ pub use semantics::{
 };
 pub use value::{Literal, Value};
 
+/// Whether a device takes the built-in meanings of CiA 301 and its device
+/// profile (bit fields, states, named values, units of the standard
+/// objects) where its sources say nothing.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ProfileChoice {
+    /// The built-in meanings apply (the default).
+    #[default]
+    Builtin,
+    /// Only what the sources say (YAML `profiles: none`).
+    None,
+}
+
+impl ProfileChoice {
+    pub fn is_builtin(&self) -> bool {
+        *self == ProfileChoice::Builtin
+    }
+}
+
 /// Where an item came from: a file and a 1-based line.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
 pub struct Origin {
@@ -55,6 +74,10 @@ pub struct Device {
     /// Product variants (YAML only), in source order.
     #[serde(default)]
     pub variants: Vec<Variant>,
+    /// Whether the built-in meanings of the standard objects apply (a
+    /// table's `profiles:` key).
+    #[serde(default, skip_serializing_if = "ProfileChoice::is_builtin")]
+    pub profiles: ProfileChoice,
 }
 
 impl Device {

@@ -1,6 +1,7 @@
 //! CiA 301 (CANopen application layer and communication profile): the
 //! communication objects every device may have, 0x1000–0x1FFF.
 
+use super::meaning::{StdBit, StdMeaning, StdValues, bit, field};
 use super::{NumberedRange, StdName, obj, sub};
 
 /// Objects with one fixed index, and their standard sub-entries.
@@ -211,4 +212,140 @@ pub(super) const RANGES: &[NumberedRange] = &[
         // Subs 1 to 64 are the mapped application objects: one list.
         list: true,
     },
+];
+
+/// What CiA 301 (and CiA 302 for the NMT start-up) fixes about its objects
+/// (see `super::meaning`).
+#[rustfmt::skip]
+pub(super) const MEANINGS: &[StdMeaning] = &[
+    StdMeaning::at(0x1001, 0).bits(ERROR_REGISTER_BITS),
+    StdMeaning::at(0x1005, 0).bits(COB_ID_SYNC_BITS),
+    StdMeaning::at(0x1006, 0).unit("µs"),
+    StdMeaning::at(0x1007, 0).unit("µs"),
+    StdMeaning::at(0x100C, 0).unit("ms"),
+    StdMeaning::at(0x1014, 0).bits(COB_ID_EMCY_BITS),
+    StdMeaning::at(0x1015, 0).scaled("ms", 0.1),
+    StdMeaning::at(0x1016, 1).subs(1, 127).bits(HEARTBEAT_CONSUMER_BITS),
+    StdMeaning::at(0x1017, 0).unit("ms"),
+    // PDO communication parameters: RPDOs, then TPDOs. Their value types
+    // are the runtime's (`od::standard`), not generated per PDO.
+    StdMeaning::at(0x1400, 1).objects(0x15FF).bits(PDO_COB_ID_BITS).runtime_value("od::standard::PdoCobId", "u32"),
+    StdMeaning::at(0x1400, 2).objects(0x15FF).values(TRANSMISSION_TYPES).runtime_value("od::standard::TransmissionType", "u8"),
+    StdMeaning::at(0x1400, 3).objects(0x15FF).scaled("ms", 0.1).runtime_value("od::standard::InhibitTime", "u16"),
+    StdMeaning::at(0x1400, 5).objects(0x15FF).unit("ms").runtime_value("od::standard::EventTimer", "u16"),
+    StdMeaning::at(0x1800, 1).objects(0x19FF).bits(PDO_COB_ID_BITS).runtime_value("od::standard::PdoCobId", "u32"),
+    StdMeaning::at(0x1800, 2).objects(0x19FF).values(TRANSMISSION_TYPES).runtime_value("od::standard::TransmissionType", "u8"),
+    StdMeaning::at(0x1800, 3).objects(0x19FF).scaled("ms", 0.1).runtime_value("od::standard::InhibitTime", "u16"),
+    StdMeaning::at(0x1800, 5).objects(0x19FF).unit("ms").runtime_value("od::standard::EventTimer", "u16"),
+    StdMeaning::at(0x1F80, 0).bits(NMT_STARTUP_BITS),
+];
+
+const ERROR_REGISTER_BITS: &[StdBit] = &[
+    bit(0, "generic error", None),
+    bit(1, "current", None),
+    bit(2, "voltage", None),
+    bit(3, "temperature", None),
+    bit(4, "communication error", Some("Overrun, error state")),
+    bit(5, "device profile specific", None),
+    bit(7, "manufacturer specific", None),
+];
+
+const COB_ID_SYNC_BITS: &[StdBit] = &[
+    field(0, 29, "CAN-ID", None),
+    bit(
+        29,
+        "extended frame",
+        Some("1 = 29-bit CAN-ID, 0 = 11-bit (bits 11 to 28 zero)"),
+    ),
+    bit(
+        30,
+        "generate",
+        Some("1 = this device produces the SYNC message"),
+    ),
+];
+
+const COB_ID_EMCY_BITS: &[StdBit] = &[
+    field(0, 29, "CAN-ID", None),
+    bit(
+        29,
+        "extended frame",
+        Some("1 = 29-bit CAN-ID, 0 = 11-bit (bits 11 to 28 zero)"),
+    ),
+    bit(
+        31,
+        "not valid",
+        Some("1 = the EMCY message does not exist (is not valid)"),
+    ),
+];
+
+const PDO_COB_ID_BITS: &[StdBit] = &[
+    field(0, 29, "CAN-ID", None),
+    bit(
+        29,
+        "extended frame",
+        Some("1 = 29-bit CAN-ID, 0 = 11-bit (bits 11 to 28 zero)"),
+    ),
+    bit(
+        30,
+        "no RTR",
+        Some("1 = no remote transmission request allowed on this PDO"),
+    ),
+    bit(
+        31,
+        "not valid",
+        Some("1 = the PDO does not exist (is not valid); its mapping may be changed"),
+    ),
+];
+
+/// A PDO's transmission type.
+const TRANSMISSION_TYPES: StdValues = StdValues {
+    numeric: Some((1, 240)),
+    named: &[
+        (0, 0, "synchronous acyclic"),
+        (241, 251, "reserved"),
+        (252, 252, "RTR only synchronous"),
+        (253, 253, "RTR only event driven"),
+        (254, 254, "event driven manufacturer specific"),
+        (255, 255, "event driven device profile"),
+    ],
+    other: "reserved",
+};
+
+const HEARTBEAT_CONSUMER_BITS: &[StdBit] = &[
+    field(0, 16, "heartbeat time", Some("ms")),
+    field(16, 8, "node id", None),
+];
+
+const NMT_STARTUP_BITS: &[StdBit] = &[
+    bit(0, "NMT master", Some("1 = this device is the NMT master")),
+    bit(
+        1,
+        "start all nodes",
+        Some("1 = the master starts all nodes at once (NMT start all); 0 = each assigned slave"),
+    ),
+    bit(
+        2,
+        "no auto operational",
+        Some("1 = the master does not enter operational by itself"),
+    ),
+    bit(
+        3,
+        "no slave start",
+        Some("1 = the application, not the master, starts the slaves"),
+    ),
+    bit(
+        4,
+        "reset all on error",
+        Some("1 = an error control event of a mandatory slave resets all nodes"),
+    ),
+    bit(
+        5,
+        "flying master",
+        Some("1 = the device takes part in the flying master process"),
+    ),
+    bit(
+        6,
+        "stop all on error",
+        Some("1 = an error control event of a mandatory slave stops all nodes (bit 4 = 0)"),
+    ),
 ];

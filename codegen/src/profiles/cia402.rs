@@ -1,6 +1,7 @@
 //! CiA 402 (drives and motion control, IEC 61800-7-201): the device profile
 //! objects 0x6000–0x6FFF of a drive.
 
+use super::meaning::{StdBit, StdMeaning, StdPattern, StdValues, bit, pattern};
 use super::{StdName, obj, sub};
 
 pub(super) const OBJECTS: &[StdName] = &[
@@ -220,4 +221,177 @@ pub(super) const OBJECTS: &[StdName] = &[
         "HttpDriveCatalogueAddress",
         "Http drive catalogue address",
     ),
+];
+
+/// What CiA 402 fixes about its objects (see `super::meaning`): the
+/// controlword and statusword bits and states, the modes of operation and
+/// the option codes, and the units the profile itself sets.
+#[rustfmt::skip]
+pub(super) const MEANINGS: &[StdMeaning] = &[
+    StdMeaning::at(0x6040, 0).bits(CONTROLWORD_BITS).runtime("cia402::Controlword", "u16", true),
+    StdMeaning::at(0x6041, 0).bits(STATUSWORD_BITS).patterns(STATES).runtime("cia402::Statusword", "u16", true),
+    StdMeaning::at(0x605A, 0).values(StdValues { numeric: None, named: QUICK_STOP_OPTIONS, other: "reserved" }),
+    StdMeaning::at(0x605B, 0).values(StdValues { numeric: None, named: SHUTDOWN_OPTIONS, other: "reserved" }),
+    StdMeaning::at(0x605C, 0).values(StdValues { numeric: None, named: DISABLE_OPERATION_OPTIONS, other: "reserved" }),
+    StdMeaning::at(0x605D, 0).values(StdValues { numeric: None, named: HALT_OPTIONS, other: "reserved" }),
+    StdMeaning::at(0x605E, 0).values(StdValues { numeric: None, named: FAULT_REACTION_OPTIONS, other: "reserved" }),
+    StdMeaning::at(0x6060, 0).values(MODES).runtime("cia402::ModeOfOperation", "i8", false),
+    StdMeaning::at(0x6061, 0).values(MODES).runtime("cia402::ModeOfOperation", "i8", false),
+    StdMeaning::at(0x6066, 0).unit("ms"),
+    StdMeaning::at(0x6068, 0).unit("ms"),
+    StdMeaning::at(0x606E, 0).unit("ms"),
+    StdMeaning::at(0x6070, 0).unit("ms"),
+    // Torques and currents in thousandths of the motor's rated torque
+    // (0x6076) and rated current (0x6075).
+    StdMeaning::at(0x6071, 0).unit("‰ rated torque"),
+    StdMeaning::at(0x6072, 0).unit("‰ rated torque"),
+    StdMeaning::at(0x6073, 0).unit("‰ rated current"),
+    StdMeaning::at(0x6074, 0).unit("‰ rated torque"),
+    StdMeaning::at(0x6075, 0).unit("mA"),
+    StdMeaning::at(0x6076, 0).unit("mNm"),
+    StdMeaning::at(0x6077, 0).unit("‰ rated torque"),
+    StdMeaning::at(0x6078, 0).unit("‰ rated current"),
+    StdMeaning::at(0x6079, 0).unit("mV"),
+    StdMeaning::at(0x6087, 0).unit("‰ rated torque/s"),
+];
+
+const CONTROLWORD_BITS: &[StdBit] = &[
+    bit(0, "switch on", None),
+    bit(1, "enable voltage", None),
+    bit(
+        2,
+        "quick stop",
+        Some("0 = quick stop (the bit is active low)"),
+    ),
+    bit(3, "enable operation", None),
+    bit(
+        4,
+        "new set-point",
+        Some(
+            "Profile position: new set-point; homing: homing operation start; other modes: operation mode specific",
+        ),
+    ),
+    bit(
+        5,
+        "change set immediately",
+        Some("Profile position: 1 = the new set-point replaces the running one"),
+    ),
+    bit(
+        6,
+        "relative",
+        Some("Profile position: 0 = absolute target, 1 = relative target"),
+    ),
+    bit(7, "fault reset", Some("A rising edge resets a fault")),
+    bit(8, "halt", None),
+    bit(
+        9,
+        "change on set-point",
+        Some("Profile position: 1 = the next set-point follows without stopping"),
+    ),
+];
+
+const STATUSWORD_BITS: &[StdBit] = &[
+    bit(0, "ready to switch on", None),
+    bit(1, "switched on", None),
+    bit(2, "operation enabled", None),
+    bit(3, "fault", None),
+    bit(4, "voltage enabled", None),
+    bit(
+        5,
+        "quick stop",
+        Some("0 = a quick stop is active (the bit is active low)"),
+    ),
+    bit(6, "switch on disabled", None),
+    bit(7, "warning", None),
+    bit(9, "remote", Some("1 = the controlword is processed")),
+    bit(10, "target reached", None),
+    bit(11, "internal limit active", None),
+    bit(
+        12,
+        "set-point acknowledge",
+        Some(
+            "Profile position: set-point acknowledge; profile velocity: speed 0; homing: homing attained; cyclic synchronous modes: drive follows the command value",
+        ),
+    ),
+    bit(
+        13,
+        "following error",
+        Some(
+            "Profile position and cyclic synchronous position: following error; profile velocity: max slippage error; homing: homing error",
+        ),
+    ),
+];
+
+/// The states of the power drive state machine (the statusword masks).
+const STATES: &[StdPattern] = &[
+    pattern("not ready to switch on", 0x004F, 0x0000),
+    pattern("switch on disabled", 0x004F, 0x0040),
+    pattern("ready to switch on", 0x006F, 0x0021),
+    pattern("switched on", 0x006F, 0x0023),
+    pattern("operation enabled", 0x006F, 0x0027),
+    pattern("quick stop active", 0x006F, 0x0007),
+    pattern("fault reaction active", 0x004F, 0x000F),
+    pattern("fault", 0x004F, 0x0008),
+];
+
+/// Modes of operation (0x6060, 0x6061); negative values are the
+/// manufacturer's own modes.
+const MODES: StdValues = StdValues {
+    numeric: None,
+    named: &[
+        (-128, -1, "manufacturer specific"),
+        (0, 0, "no mode"),
+        (1, 1, "profile position"),
+        (2, 2, "velocity"),
+        (3, 3, "profile velocity"),
+        (4, 4, "profile torque"),
+        (6, 6, "homing"),
+        (7, 7, "interpolated position"),
+        (8, 8, "cyclic synchronous position"),
+        (9, 9, "cyclic synchronous velocity"),
+        (10, 10, "cyclic synchronous torque"),
+    ],
+    other: "reserved",
+};
+
+const QUICK_STOP_OPTIONS: &[(i128, i128, &str)] = &[
+    (-32768, -1, "manufacturer specific"),
+    (0, 0, "disable drive function"),
+    (1, 1, "slow down ramp then switch on disabled"),
+    (2, 2, "quick stop ramp then switch on disabled"),
+    (3, 3, "current limit then switch on disabled"),
+    (4, 4, "voltage limit then switch on disabled"),
+    (5, 5, "slow down ramp and stay in quick stop active"),
+    (6, 6, "quick stop ramp and stay in quick stop active"),
+    (7, 7, "current limit and stay in quick stop active"),
+    (8, 8, "voltage limit and stay in quick stop active"),
+];
+
+const SHUTDOWN_OPTIONS: &[(i128, i128, &str)] = &[
+    (-32768, -1, "manufacturer specific"),
+    (0, 0, "disable drive function"),
+    (1, 1, "slow down ramp then disable drive function"),
+];
+
+const DISABLE_OPERATION_OPTIONS: &[(i128, i128, &str)] = &[
+    (-32768, -1, "manufacturer specific"),
+    (0, 0, "disable drive function"),
+    (1, 1, "slow down ramp then disable drive function"),
+];
+
+const HALT_OPTIONS: &[(i128, i128, &str)] = &[
+    (-32768, -1, "manufacturer specific"),
+    (1, 1, "slow down ramp"),
+    (2, 2, "quick stop ramp"),
+    (3, 3, "current limit"),
+    (4, 4, "voltage limit"),
+];
+
+const FAULT_REACTION_OPTIONS: &[(i128, i128, &str)] = &[
+    (-32768, -1, "manufacturer specific"),
+    (0, 0, "disable drive function, motor free to rotate"),
+    (1, 1, "slow down ramp"),
+    (2, 2, "quick stop ramp"),
+    (3, 3, "current limit"),
+    (4, 4, "voltage limit"),
 ];

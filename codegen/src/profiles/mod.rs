@@ -1,6 +1,7 @@
-//! The canonical names of standard objects: CiA 301 and the device
+//! The canonical names and built-in meanings of standard objects: CiA 301 and the device
 //! profiles, one file per profile, as plain data (index, optional sub, the
-//! Rust name and the standard's own name text). The generator names a
+//! Rust name and the standard's own name text; and, in [`meaning`], the
+//! bit fields, states, named values and units the standard fixes). The generator names a
 //! standard object by this table, not by the vendor's spelling, so a
 //! firmware update that renames `ParameterName` renames nothing in Rust;
 //! and every name here is reserved, whether or not the object is present,
@@ -12,12 +13,15 @@
 use std::collections::HashSet;
 use std::sync::OnceLock;
 
-use crate::ir::{Device, Value};
+use crate::ir::{DataType, Device, ObjectKind, Value};
 
 mod cia301;
 mod cia401;
 mod cia402;
 mod cia406;
+mod meaning;
+
+pub(crate) use meaning::{RuntimeType, apply};
 
 /// One standard name: an object (`sub: None`) or one of its sub-entries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -91,8 +95,10 @@ pub(crate) enum Profile {
 impl Profile {
     /// The profile `device` implements: the low 16 bits of the device
     /// type (0x1000, its `ParameterValue` or else its default) when they
-    /// are 401, 402 or 406; otherwise CiA 402 when both 0x6040 and 0x6041
-    /// exist; otherwise none.
+    /// are 401, 402 or 406; otherwise, when the device type names no other
+    /// profile (0 or absent), CiA 402 when 0x6040 and 0x6041 are what the
+    /// profile makes them (UNSIGNED16 variables: a CiA 418 battery has
+    /// arrays there); otherwise none.
     pub(crate) fn of(device: &Device) -> Option<Profile> {
         let device_type = device
             .objects
@@ -107,10 +113,16 @@ impl Profile {
             Some(401) => return Some(Profile::Cia401),
             Some(402) => return Some(Profile::Cia402),
             Some(406) => return Some(Profile::Cia406),
-            _ => {}
+            Some(0) | None => {}
+            Some(_) => return None,
         }
-        (device.objects.contains_key(&0x6040) && device.objects.contains_key(&0x6041))
-            .then_some(Profile::Cia402)
+        let word = |index: u16| {
+            device.objects.get(&index).is_some_and(|o| {
+                o.kind == ObjectKind::Var
+                    && o.entries.get(&0).is_some_and(|e| e.data_type == DataType::Unsigned16)
+            })
+        };
+        (word(0x6040) && word(0x6041)).then_some(Profile::Cia402)
     }
 
     fn objects(self) -> &'static [StdName] {
@@ -215,6 +227,14 @@ impl Canonical {
     }
 }
 
+/// Whether `device` is a CiA 402 drive: its device type (0x1000) names
+/// profile 402, or names none and the drive's controlword and statusword
+/// (0x6040, 0x6041, UNSIGNED16) are there. The rule the generator's
+/// built-in meanings follow, for tools that read files at run time.
+pub fn is_cia402(device: &Device) -> bool {
+    Profile::of(device) == Some(Profile::Cia402)
+}
+
 /// How many objects (with a fixed index, not counting sub-entries) and
 /// numbered ranges each table names: for the documentation and a test.
 #[cfg(test)]
@@ -302,3 +322,4 @@ mod tests {
         }
     }
 }
+

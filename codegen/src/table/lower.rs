@@ -12,7 +12,7 @@ use serde_saphyr::Spanned;
 
 use super::schema::{DeviceDef, Table};
 use super::{At, Base, Ctx};
-use crate::ir::{Device, Identity};
+use crate::ir::{Device, Identity, ProfileChoice};
 
 /// Lowers `table`; every file read on the way (a `base:` EDS) is appended
 /// to `files`.
@@ -117,6 +117,19 @@ pub(super) fn lower(ctx: &mut Ctx, table: &Table, base: Base, files: &mut Vec<Pa
     let changes = changed_objects(table);
     super::pdo::check_mappings(ctx, &device, &written, &base_problems, &changes);
     device.fill_identity_from_1018();
+    if let Some(choice) = &table.profiles {
+        match choice.value.as_str() {
+            "none" => device.profiles = ProfileChoice::None,
+            "builtin" => device.profiles = ProfileChoice::Builtin,
+            other => ctx.error(
+                "table::bad-profiles",
+                At::of(choice),
+                "",
+                "profiles",
+                format!("`profiles: {other}` is not known; write `none` (no built-in meanings of the standard objects) or `builtin` (the default)"),
+            ),
+        }
+    }
     device
 }
 

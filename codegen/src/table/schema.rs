@@ -43,6 +43,10 @@ pub struct Table {
     pub variants: Vec<Spanned<VariantDef>>,
     /// Rule levels for this device: `allow:` and `deny:` lists of rule codes.
     pub diagnostics: Option<Spanned<DiagnosticsDef>>,
+    /// `none`: no built-in meanings of the standard objects (CiA 301 and
+    /// the device profile); `builtin` (the default): they apply where the
+    /// sources say nothing.
+    pub profiles: Option<Text>,
 }
 
 /// The `diagnostics:` section: which rules to allow (their warnings are

@@ -20,11 +20,11 @@ pub mod mapping {
     #[pdo(tpdo = 2)]
     pub struct StatusPosition {
         #[pdo(entry = od::Statusword)]
-        pub status: u16,
+        pub status: od::StatuswordValue,
         #[pdo(entry = od::PositionActualValue)]
         pub position: i32,
         #[pdo(entry = od::ModesOfOperation)]
-        pub mode: i8,
+        pub mode: od::ModesOfOperationValue,
     }
 
     /// What the control loop writes: controlword and target velocity.

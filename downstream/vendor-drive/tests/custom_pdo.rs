@@ -13,6 +13,7 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant as WallClock};
 
+use eds2rust_runtime::cia402;
 use eds2rust_runtime::blocking::{self, SdoClient};
 use eds2rust_runtime::od::{NodeId, Pdo as _};
 use eds2rust_runtime::pdo::PdoConfig;
@@ -60,7 +61,8 @@ fn configured_over_sdo_applied_and_received() {
     assert_eq!(sdo.upload(0x1600, 2).unwrap(), 0x60FF_0020u32.to_le_bytes());
 
     // A value the TPDO will carry: the mode of operation, set over SDO.
-    sdo.write::<od::ModesOfOperation>(3).unwrap();
+    sdo.write::<od::ModesOfOperation>(od::ModesOfOperationValue::from_raw(3))
+        .unwrap();
     watch
         .send(&Frame::new(CanId::Standard(0), &[0x01, drive.get()]).unwrap())
         .unwrap();
@@ -68,7 +70,8 @@ fn configured_over_sdo_applied_and_received() {
 
     // The RPDO is written into the drive's objects.
     let command = ControlVelocity {
-        control: 0x000F,
+        // Enable operation, as the runtime's CiA 402 command says it.
+        control: cia402::Controlword::from_command(cia402::Command::EnableOperation).into(),
         velocity: -2500,
     };
     let id = ControlVelocity::can_id(drive) as u16;
@@ -90,7 +93,7 @@ fn configured_over_sdo_applied_and_received() {
             }
         }
     };
-    assert_eq!(received.mode, 3);
+    assert_eq!(received.mode.to_raw(), 3);
     assert_eq!(received.status, sdo.read::<od::Statusword>().unwrap());
     assert_eq!(
         received.position,
@@ -159,9 +162,9 @@ fn configured_over_sdo_applied_and_received() {
         .collect();
     let p = StatusPosition::decode(&data).unwrap();
     let ours = vec![
-        i64::from(p.status),
+        i64::from(p.status.to_raw()),
         i64::from(p.position),
-        i64::from(p.mode),
+        i64::from(p.mode.to_raw()),
     ];
     assert_eq!(theirs, ours, "data {data:02X?}");
     stop.store(true, Ordering::Relaxed);

@@ -1,5 +1,6 @@
 //! The generated API as a user sees it: typed entries and PDO structs.
 
+use eds2rust_runtime::cia402;
 use eds2rust_runtime::od::{Entry, NodeId, Pdo};
 use vendor_drive::drive::{od, pdo};
 
@@ -13,8 +14,18 @@ fn typed_entries() {
 fn tpdo1_decodes_statusword_mode_and_timestamp() {
     let frame = [0x37, 0x02, 0x01, 0x78, 0x56, 0x34, 0x12];
     let tpdo = pdo::Tpdo1::decode(&frame).unwrap();
-    assert_eq!(tpdo.statusword, 0x0237);
-    assert_eq!(tpdo.modes_of_operation_display, 1);
+    // The vendor DCF says nothing of the statusword's bits or the modes:
+    // they are the built-in CiA 402 meaning, and the statusword is the
+    // runtime's `cia402::Statusword` at no cost.
+    assert_eq!(tpdo.statusword.to_raw(), 0x0237);
+    assert!(tpdo.statusword.is_operation_enabled());
+    let status = cia402::Statusword::from(tpdo.statusword);
+    assert_eq!(status.state(), Some(cia402::State::OperationEnabled));
+    assert_eq!(tpdo.modes_of_operation_display.to_raw(), 1);
+    assert_eq!(
+        cia402::ModeOfOperation::from(tpdo.modes_of_operation_display),
+        cia402::ModeOfOperation::ProfilePosition
+    );
     assert_eq!(tpdo.timestamp, 0x1234_5678);
     assert_eq!(tpdo.encode(), frame);
     assert!(pdo::Tpdo1::decode(&frame[..6]).is_err());

@@ -7,7 +7,7 @@ use eds2rust_drivers::runtime::Pdo;
 #[pdo(tpdo = 1, runtime = eds2rust_drivers::runtime)]
 pub struct Sync {
     #[pdo(entry = od::CobIdSync)]
-    pub cob_id: u32,
+    pub cob_id: od::CobIdSyncValue,
 }
 
 fn main() {}

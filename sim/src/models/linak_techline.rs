@@ -416,9 +416,12 @@ impl LinakTechline {
     /// TPDO2 (parallel feedback) is marked invalid.
     fn communication_reset(&mut self, ctx: &mut Context<'_, LinakTechlineEvent>) {
         self.heartbeat_lost = false;
-        ctx.set::<od::rpdo1_communication_parameter::TransmissionType>(0xFF);
-        if let Some(cob) = ctx.get::<od::tpdo2_communication_parameter::CobIdUsedByTpdo>() {
-            ctx.set::<od::tpdo2_communication_parameter::CobIdUsedByTpdo>(cob | 0x8000_0000);
+        use eds2rust_runtime::od::standard::TransmissionType as Type;
+        use od::rpdo1_communication_parameter::TransmissionType;
+        use od::tpdo2_communication_parameter::CobIdUsedByTpdo;
+        ctx.set::<TransmissionType>(Type::EVENT_DRIVEN);
+        if let Some(cob) = ctx.get::<CobIdUsedByTpdo>() {
+            ctx.set::<CobIdUsedByTpdo>(cob.with_not_valid(true));
         }
         self.publish(ctx, true);
     }

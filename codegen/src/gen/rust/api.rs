@@ -232,7 +232,7 @@ fn entry_lines(
     );
     let path = |id| format!("{module}::{}", names.text(id));
     match &e.value {
-        Plan::Prim(_) | Plan::Bytes(_) | Plan::Error(_) => {}
+        Plan::Prim(_) | Plan::Bytes(_) | Plan::Error(_) | Plan::Runtime { .. } => {}
         Plan::Scaled { raw, .. } => {
             lines.push(
                 k(),

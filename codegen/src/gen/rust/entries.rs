@@ -137,7 +137,7 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
 fn info(cx: &Ctx, module: &[Ident], e: &od_plan::EntryPlan, names: &Names) -> EntryInfo {
     let rust_name = e.fixed_name.then(|| names.text(e.zst).to_string());
     let (value, raw) = match &e.value {
-        Plan::Prim(p) => (None, Some(*p)),
+        Plan::Prim(p) | Plan::Runtime { raw: p, .. } => (None, Some(*p)),
         Plan::Bytes(_) => (None, None),
         Plan::Error(i) => {
             let plan = &cx.errors[*i];
@@ -225,7 +225,7 @@ fn entry_items(
             }
         });
     }
-    if let Some(default_for) = node_default_tokens(rt, entry, plan) {
+    if let Some(default_for) = node_default_tokens(rt, entry, plan, &value_ty) {
         out.extend(quote!(impl #ident { #default_for }));
     }
     let mut vcx = values::Ctx {
@@ -233,6 +233,10 @@ fn entry_items(
         diags: cx.diags,
     };
     out.extend(values::emit(&mut vcx, entry, plan, names));
+    let canonical = crate::profiles::Canonical::of(cx.device);
+    if let Some(ty) = canonical.runtime_type(object.index, entry.subindex) {
+        out.extend(values::runtime_conversions(rt, plan, names, ty));
+    }
     out
 }
 
@@ -292,7 +296,11 @@ pub(super) fn default_tokens(
     let raw = match plan {
         Plan::Prim(p) => *p,
         Plan::Bytes(_) => return None,
-        Plan::Error(_) | Plan::Enum { .. } | Plan::Bits { .. } | Plan::Scaled { .. } => {
+        Plan::Error(_)
+        | Plan::Enum { .. }
+        | Plan::Bits { .. }
+        | Plan::Scaled { .. }
+        | Plan::Runtime { .. } => {
             let raw_prim = Prim::of(entry.data_type)?;
             let lit = raw_literal(&literal.value, raw_prim)?;
             return Some(quote!(#value_ty::from_raw(#lit)));
@@ -303,10 +311,19 @@ pub(super) fn default_tokens(
 
 /// `default_for(node_id)` for a `$NODEID`-relative default of an integer
 /// entry (COB-IDs of EMCY, SDO and PDOs), when every node id fits the type.
-fn node_default_tokens(rt: &TokenStream, entry: &Entry, plan: &Plan) -> Option<TokenStream> {
+fn node_default_tokens(
+    rt: &TokenStream,
+    entry: &Entry,
+    plan: &Plan,
+    value_ty: &TokenStream,
+) -> Option<TokenStream> {
     let literal = entry.default.as_ref().filter(|l| l.plus_node_id)?;
-    let Plan::Prim(raw) = plan else {
-        return None;
+    let raw = match plan {
+        Plan::Prim(raw) => *raw,
+        Plan::Enum { .. } | Plan::Bits { .. } | Plan::Scaled { .. } | Plan::Runtime { .. } => {
+            Prim::of(entry.data_type)?
+        }
+        Plan::Bytes(_) | Plan::Error(_) => return None,
     };
     let Value::Integer(offset) = literal.value else {
         return None;
@@ -321,10 +338,14 @@ fn node_default_tokens(rt: &TokenStream, entry: &Entry, plan: &Plan) -> Option<T
         " The default value for a node: {}.",
         docs::text(&literal.text)
     );
+    let body = match plan {
+        Plan::Prim(_) => quote!(#lit + node_id.get() as #ty),
+        _ => quote!(#value_ty::from_raw(#lit + node_id.get() as #ty)),
+    };
     Some(quote! {
         #[doc = #doc]
-        #[inline] pub const fn default_for(node_id: #rt::od::NodeId) -> #ty {
-            #lit + node_id.get() as #ty
+        #[inline] pub const fn default_for(node_id: #rt::od::NodeId) -> #value_ty {
+            #body
         }
     })
 }

@@ -165,8 +165,10 @@ pub(crate) fn plan<'d>(
                         &entry.origin,
                     );
                     let fixed_name = matches!(name, values::Name::Fixed(_));
-                    let value =
-                        values::plan(entry, name, error_plan(device, errors, entry), &mut ns);
+                    let value = values::runtime_plan(canonical, object.index, entry)
+                        .unwrap_or_else(|| {
+                            values::plan(entry, name, error_plan(device, errors, entry), &mut ns)
+                        });
                     EntryPlan {
                         entry,
                         zst,
@@ -347,6 +349,7 @@ pub(crate) fn value_type_path(
         Plan::Enum { name, .. } | Plan::Bits { name, .. } | Plan::Scaled { name, .. } => {
             format!("{module}::{}", names.text(*name))
         }
+        Plan::Runtime { path, .. } => format!("runtime::{path}"),
     }
 }
 

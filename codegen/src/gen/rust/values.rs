@@ -41,13 +41,16 @@ pub(crate) enum Plan {
     },
     /// A newtype with unit and scale.
     Scaled { name: NameId, raw: Prim },
+    /// A type of the runtime that CiA 301 fixes (`od::standard::PdoCobId`),
+    /// generated nowhere.
+    Runtime { path: &'static str, raw: Prim },
 }
 
 impl Plan {
     /// Every name the plan requested in the entry's scope.
     pub(crate) fn names(&self) -> Vec<NameId> {
         match self {
-            Plan::Prim(_) | Plan::Bytes(_) | Plan::Error(_) => Vec::new(),
+            Plan::Prim(_) | Plan::Bytes(_) | Plan::Error(_) | Plan::Runtime { .. } => Vec::new(),
             Plan::Enum {
                 name, kind, number, ..
             } => [Some(*name), Some(*kind), *number]
@@ -175,7 +178,26 @@ pub(crate) fn type_tokens(
             let name = names.get(*name);
             quote!(#name)
         }
+        Plan::Runtime { path, .. } => {
+            let path: TokenStream = path.parse().expect("a runtime path is Rust");
+            quote!(#rt::#path)
+        }
     }
+}
+
+/// The runtime's value type for `entry` of object `index`, when CiA 301
+/// fixes one and the entry keeps the standard's meaning.
+pub(crate) fn runtime_plan(
+    canonical: crate::profiles::Canonical,
+    index: u16,
+    entry: &Entry,
+) -> Option<Plan> {
+    let ty = canonical.runtime_value(index, entry)?;
+    let raw = Prim::of(entry.data_type)?;
+    (raw.tokens().to_string() == ty.raw).then_some(Plan::Runtime {
+        path: ty.path,
+        raw,
+    })
 }
 
 /// Everything the value-type emitters need of their surroundings.
@@ -189,7 +211,9 @@ pub(crate) struct Ctx<'a> {
 pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> TokenStream {
     let s = &entry.semantics;
     match plan {
-        Plan::Prim(_) | Plan::Bytes(_) | Plan::Error(_) => TokenStream::new(),
+        Plan::Prim(_) | Plan::Bytes(_) | Plan::Error(_) | Plan::Runtime { .. } => {
+            TokenStream::new()
+        }
         Plan::Scaled { name, raw } => {
             let mut doc = value_doc(entry, "The value");
             unit_doc(&mut doc, s);
@@ -358,6 +382,51 @@ pub(crate) fn scalar_impl(rt: &TokenStream, name: &Ident, raw: Prim) -> TokenStr
             fn from_raw(raw: u64) -> Self {
                 Self::from_raw(#from)
             }
+        }
+    }
+}
+
+/// `From` both ways between a generated value type and the runtime type
+/// the standard gives the entry (`cia402::Statusword`): the same raw value,
+/// so the conversions compile to nothing. Nothing when the value type is
+/// not generated or its raw type differs from the runtime type's.
+pub(crate) fn runtime_conversions(
+    rt: &TokenStream,
+    plan: &Plan,
+    names: &Names,
+    ty: crate::profiles::RuntimeType,
+) -> TokenStream {
+    let (Plan::Enum { name, raw, .. } | Plan::Bits { name, raw, .. }) = plan else {
+        return TokenStream::new();
+    };
+    if raw.tokens().to_string() != ty.raw {
+        return TokenStream::new();
+    }
+    let name = names.get(*name);
+    let path: TokenStream = ty.path.parse().expect("a runtime path is Rust");
+    let raw_ty = raw.tokens();
+    let (into_rt, from_rt) = if ty.newtype {
+        (
+            quote!(#rt::#path(value.to_raw())),
+            quote!(Self::from_raw(value.0)),
+        )
+    } else {
+        (
+            quote!(#rt::#path::from(value.to_raw())),
+            quote!(Self::from_raw(#raw_ty::from(value))),
+        )
+    };
+    let doc = format!(" The runtime's `{}`: the same raw value.", ty.path);
+    quote! {
+        impl ::core::convert::From<#name> for #rt::#path {
+            #[doc = #doc]
+            #[inline]
+            fn from(value: #name) -> Self { #into_rt }
+        }
+        impl ::core::convert::From<#rt::#path> for #name {
+            #[doc = " The same raw value as the runtime's type."]
+            #[inline]
+            fn from(value: #rt::#path) -> Self { #from_rt }
         }
     }
 }

@@ -83,7 +83,7 @@ impl Errors {
         }
         self.active.push(error);
         if let Some((emcy, _)) = emcy_of(error) {
-            ctx.set::<od::ErrorRegister>(self.register());
+            ctx.set::<od::ErrorRegister>(od::ErrorRegisterValue::from_raw(self.register()));
             ctx.emcy(EmcyCode::from_kind(emcy).to_raw(), [0; 5]);
         }
         true
@@ -99,7 +99,7 @@ impl Errors {
         self.active.remove(i);
         if emcy_of(error).is_some() {
             let register = self.register();
-            ctx.set::<od::ErrorRegister>(register);
+            ctx.set::<od::ErrorRegister>(od::ErrorRegisterValue::from_raw(register));
             if register == 0 {
                 ctx.emcy(EmcyCode::from_kind(Emcy::NoError).to_raw(), [0; 5]);
                 ctx.clear_error_field();
