@@ -25,9 +25,11 @@ use crate::transport::{Bus, Clock};
 use crate::{Instant, Service};
 
 mod error;
-mod master;
+pub(crate) mod master;
 mod stream;
-pub use master::{LssRequestError, MASTER_QUEUE_CAPACITY, Master};
+pub use master::{
+    Cia402Error, DRIVE_EVENTS_KEPT, DriveHandle, LssRequestError, MASTER_QUEUE_CAPACITY, Master,
+};
 
 /// How often [`serve`] looks at its stop flag while nothing happens.
 pub const STOP_POLL: Duration = Duration::from_millis(10);
@@ -239,6 +241,7 @@ impl Transfer<'_> {
 /// The data a transfer ended with (empty for downloads), and whether it
 /// is an expedited response's padded 4 bytes
 /// ([`ClientEvent::Uploaded`]'s `padded`).
+#[derive(Debug)]
 pub(crate) struct Upload {
     pub(crate) data: Vec<u8>,
     pub(crate) padded: bool,

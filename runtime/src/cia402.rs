@@ -10,6 +10,14 @@
 //!   [`Event`]s and deadlines. It enables, disables, quick-stops and resets
 //!   a drive, runs profile-position moves with the set-point handshake,
 //!   homing, profile velocity and cyclic synchronous position.
+//! - [`requirements`]: which objects each [`Operation`] needs, checked
+//!   against a device's object table before anything is sent
+//!   ([`MissingObject`]).
+//! - [`Session`]: the I/O-free loop that runs [`Request`]s (enable, moves,
+//!   velocity, homing, csp cycles) on a [`Drive`] over object reads and
+//!   writes; the blocking master runs it in
+//!   [`blocking::Master::drive`](crate::blocking::Master::drive), an async
+//!   master runs the same loop (see [`session`]).
 //! - [`DeviceStateMachine`]: the device side for simulators: fed
 //!   controlwords, faults and motion-model verdicts, it computes the
 //!   statusword with transitions 0 to 16.
@@ -18,11 +26,15 @@
 
 pub mod device;
 pub mod drive;
+pub mod requirements;
+pub mod session;
 pub mod types;
 pub mod words;
 
 pub use device::{DeviceConfig, DeviceEvent, DeviceStateMachine};
 pub use drive::Drive;
+pub use requirements::{MissingObject, Operation};
+pub use session::{OperationError, Request, Session, SessionConfig};
 pub use types::{DriveConfig, DriveError, Event, LeBytes, Move, Step, Write, WriteValue};
 pub use words::{Command, Controlword, ModeOfOperation, State, Statusword};
 

@@ -1,6 +1,12 @@
 //! Async drivers over tokio (feature `tokio`): the counterparts of
 //! [`crate::blocking`] for an [`AsyncBus`].
 //!
+//! - [`drive`] and [`serve`] run any [`Service`]; [`SdoClient`] reads and
+//!   writes the objects of one node.
+//! - [`Master`] and its [`Driver`]: the composite [`crate::master::Master`]
+//!   with SDO, NMT, PDO configuration and LSS calls, and its events and
+//!   PDOs as streams ([`Events`], [`Pdos`]).
+//!
 //! Time comes from `tokio::time::Instant` (mapped through a [`Clock`]), so
 //! the drivers follow tokio's paused clock in tests. Deadlines are
 //! [`Deadline`]s: an [`Instant`] of the cores (`now(&clock) +
@@ -22,6 +28,13 @@ use crate::sdo::typed::{self, LengthNote};
 pub use crate::time::Deadline;
 use crate::transport::{AsyncBus, Clock};
 use crate::{Instant, Service};
+
+mod master;
+pub use crate::blocking::Cia402Error;
+pub use master::{
+    DriveHandle, Driver, Events, LssRequestError, MASTER_QUEUE_CAPACITY, Master,
+    PDO_QUEUE_CAPACITY, Pdos,
+};
 
 /// The cores' time now on `clock`, read from tokio's clock (the paused
 /// clock in tests); `clock.now()` would read the std clock instead.

@@ -8,8 +8,10 @@ use std::io;
 use std::string::String;
 use std::vec::Vec;
 
-mod lss;
+mod drive;
+pub(crate) mod lss;
 
+pub use drive::{Cia402Error, DRIVE_EVENTS_KEPT, DriveHandle};
 pub use lss::LssRequestError;
 
 use super::{

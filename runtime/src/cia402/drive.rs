@@ -138,6 +138,14 @@ impl Drive {
         })
     }
 
+    /// Drops the writes not yet polled (and the csp target), for a caller
+    /// whose write failed: the rest belonged to the same request.
+    /// [`Drive::controlword`] still shows the last one queued.
+    pub fn discard_writes(&mut self) {
+        while self.writes.pop().is_some() {}
+        self.csp_target = None;
+    }
+
     /// The next event, if any.
     pub fn poll_event(&mut self) -> Option<Event> {
         self.events.pop()

@@ -159,11 +159,14 @@ pub enum Step {
     TargetReached,
     /// Homing started, waiting for homing attained or homing error.
     Homing,
+    /// Target velocity written, waiting for target reached (bit 10; used
+    /// by [`Session`](super::Session), not by the helper).
+    VelocityReached,
 }
 
 impl Step {
     /// Number of steps.
-    pub const COUNT: usize = 13;
+    pub const COUNT: usize = 14;
 
     /// Every step, in declaration order.
     pub const ALL: [Step; Step::COUNT] = [
@@ -180,19 +183,50 @@ impl Step {
         Step::SetPointAcknowledge,
         Step::TargetReached,
         Step::Homing,
+        Step::VelocityReached,
     ];
 
     /// The default timeout: 1 s for most steps, 2 s to enable operation
     /// (brake release), 5 s for start-up and fault reaction, 60 s for a
-    /// move, 120 s for homing.
+    /// move or a velocity change, 120 s for homing.
     pub const fn default_timeout(self) -> Duration {
         match self {
             Step::EnableOperation => Duration::from_secs(2),
             Step::StartUp | Step::FaultReaction => Duration::from_secs(5),
-            Step::TargetReached => Duration::from_secs(60),
+            Step::TargetReached | Step::VelocityReached => Duration::from_secs(60),
             Step::Homing => Duration::from_secs(120),
             _ => Duration::from_secs(1),
         }
+    }
+}
+
+impl Step {
+    /// What the step waits for ("set-point acknowledge (statusword bit
+    /// 12)").
+    pub const fn waits_for(self) -> &'static str {
+        match self {
+            Step::Statusword => "a statusword",
+            Step::StartUp => "the end of Not ready to switch on",
+            Step::FaultReaction => "the end of Fault reaction active",
+            Step::FaultReset => "the drive to leave Fault after a fault reset",
+            Step::Shutdown => "Ready to switch on after Shutdown",
+            Step::SwitchOn => "Switched on after Switch on",
+            Step::EnableOperation => "Operation enabled after Enable operation",
+            Step::DisableVoltage => "Switch on disabled after Disable voltage",
+            Step::QuickStop => "Quick stop active after Quick stop",
+            Step::SetPointRelease => "the previous set-point acknowledge (bit 12) to clear",
+            Step::SetPointAcknowledge => "set-point acknowledge (statusword bit 12)",
+            Step::TargetReached => "target reached (statusword bit 10)",
+            Step::Homing => "homing attained or homing error (statusword bits 12, 13)",
+            Step::VelocityReached => "target velocity reached (statusword bit 10)",
+        }
+    }
+}
+
+impl fmt::Display for Step {
+    /// "waiting for ..." (see [`Step::waits_for`]).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "waiting for {}", self.waits_for())
     }
 }
 

@@ -174,7 +174,7 @@ impl<B: Bus> Master<B> {
 }
 
 /// The value of an LSS request's end event, or the error it stands for.
-fn lss_outcome<T>(
+pub(crate) fn lss_outcome<T>(
     result: Result<LssEvent, LssRequestError>,
     value: impl FnOnce(LssEvent) -> Option<T>,
 ) -> Result<T, LssRequestError> {

@@ -1,0 +1,307 @@
+//! CiA 402 drives on the tokio [`Master`]: the async loop around
+//! [`cia402::Session`](crate::cia402::Session), the same loop as the
+//! blocking master's ([`blocking::Master::drive`](crate::blocking::Master::drive)).
+//! Writes go by SDO download, statuswords come from SDO uploads of 0x6041
+//! (every [`SessionConfig::poll_period`]) and from the statusword TPDO when
+//! one is configured (and watched by the master's PDO receiver).
+//!
+//! Every call is cancellation-safe in the sense of the master's: dropping
+//! it mid-request aborts the SDO transfer in flight and cancels the request
+//! in the session, so the next request starts from the drive's state.
+
+use std::collections::VecDeque;
+use std::vec::Vec;
+
+use super::Master;
+use crate::Instant;
+use crate::blocking::Cia402Error;
+use crate::cia402::session::{Action, Read, Request, Session, SessionConfig};
+use crate::cia402::{Event, Move, State, Statusword, object};
+use crate::master::MasterEvent;
+use crate::od::{NodeId, ObjectInfo};
+use crate::pdo::PdoEvent;
+use crate::tokio::Events;
+
+pub use crate::blocking::DRIVE_EVENTS_KEPT;
+
+impl Master {
+    /// A CiA 402 drive at `node` whose object table is `objects` (a
+    /// generated `od::OBJECTS`). The table is checked for the state
+    /// machine's objects and [`SessionConfig::required`] before anything is
+    /// sent; each call of the handle checks its own mode's objects.
+    ///
+    /// ```no_run
+    /// # async fn run(master: eds2rust_runtime::tokio::Master, objects: &'static [eds2rust_runtime::od::ObjectInfo])
+    /// # -> Result<(), eds2rust_runtime::blocking::Cia402Error> {
+    /// use eds2rust_runtime::cia402::{Move, SessionConfig};
+    /// let node = eds2rust_runtime::od::NodeId::new(2).unwrap();
+    /// let mut drive = master.drive(node, objects, SessionConfig::default())?;
+    /// drive.enable().await?;
+    /// drive.move_to(10_000, Move::default()).await?;
+    /// for (at, event) in drive.take_events() {
+    ///     println!("{at:?} {event:?}");
+    /// }
+    /// # Ok(()) }
+    /// ```
+    pub fn drive(
+        &self,
+        node: NodeId,
+        objects: &'static [ObjectInfo],
+        config: SessionConfig,
+    ) -> Result<DriveHandle, Cia402Error> {
+        let session = Session::new(objects, config)?;
+        Ok(DriveHandle::new(self.clone(), node, session))
+    }
+
+    /// Runs `request` of `session` on `node` to its end, handing each event
+    /// of the drive to `on_event` as it happens; `pdos` is the event stream
+    /// the statusword TPDO comes on (when the session has one). On an error,
+    /// or when the future is dropped, the request is cancelled in the
+    /// session.
+    pub async fn run_drive_request(
+        &self,
+        node: NodeId,
+        session: &mut Session,
+        request: Request,
+        pdos: Option<&mut Events>,
+        on_event: &mut (dyn FnMut(Instant, Event) + Send),
+    ) -> Result<(), Cia402Error> {
+        session.start(self.now(), request)?;
+        let mut guard = CancelOnDrop(Some(session));
+        let session = guard.0.as_deref_mut().expect("set above");
+        let result = self.drive_loop(node, session, pdos, on_event).await;
+        if result.is_ok() {
+            guard.0 = None;
+        }
+        result
+    }
+
+    async fn drive_loop(
+        &self,
+        node: NodeId,
+        session: &mut Session,
+        mut pdos: Option<&mut Events>,
+        on_event: &mut (dyn FnMut(Instant, Event) + Send),
+    ) -> Result<(), Cia402Error> {
+        loop {
+            let now = self.now();
+            let action = session.poll_action(now);
+            while let Some(event) = session.poll_event() {
+                on_event(now, event);
+            }
+            match action {
+                Action::Write(write) => {
+                    let (index, sub) = (write.index, write.sub);
+                    self.download(node, index, sub, &write.value.to_le_bytes())
+                        .await
+                        .map_err(|error| Cia402Error::Sdo { index, sub, error })?;
+                }
+                Action::Read(Read::Statusword) => {
+                    let data = self
+                        .upload(node, object::STATUSWORD, 0)
+                        .await
+                        .map_err(|error| Cia402Error::Sdo {
+                            index: object::STATUSWORD,
+                            sub: 0,
+                            error,
+                        })?;
+                    session.on_statusword(self.now(), &data);
+                }
+                Action::Read(Read::ErrorCode) => {
+                    // Best effort: the fault is reported without its code.
+                    let data = self.upload(node, object::ERROR_CODE, 0).await.ok();
+                    session.on_error_code(data.as_deref());
+                }
+                Action::Wait(until) => {
+                    let wake = ::tokio::time::Instant::from_std(self.clock().to_std(until));
+                    let sleep = ::tokio::time::sleep_until(wake);
+                    match pdos.as_deref_mut() {
+                        None => sleep.await,
+                        Some(events) => {
+                            ::tokio::select! {
+                                () = sleep => {}
+                                event = next_statusword_pdo(events, session) => {
+                                    if let Some((cob_id, data, len, at)) = event {
+                                        session.on_pdo(cob_id, data.get(..len).unwrap_or(&[]), at);
+                                    }
+                                }
+                            }
+                        }
+                    }
+                }
+                Action::Done(result) => return result.map_err(Cia402Error::Operation),
+            }
+        }
+    }
+}
+
+/// The next statusword TPDO on `events` (`None` when the stream ends).
+async fn next_statusword_pdo(
+    events: &mut Events,
+    session: &Session,
+) -> Option<(u16, [u8; 8], usize, Instant)> {
+    loop {
+        match events.next().await? {
+            MasterEvent::Pdo(PdoEvent::Received {
+                cob_id,
+                data,
+                len,
+                at,
+            }) if session.is_statusword_pdo(cob_id) => return Some((cob_id, data, len, at)),
+            _ => {}
+        }
+    }
+}
+
+/// Cancels the request in the session unless disarmed: an error, or the
+/// future dropped mid-request.
+struct CancelOnDrop<'a>(Option<&'a mut Session>);
+
+impl Drop for CancelOnDrop<'_> {
+    fn drop(&mut self) {
+        if let Some(session) = self.0.take() {
+            session.cancel();
+        }
+    }
+}
+
+/// One CiA 402 drive on the tokio [`Master`] (see [`Master::drive`]): the
+/// async counterpart of [`blocking::DriveHandle`](crate::blocking::DriveHandle),
+/// with the same calls. The drive's [`Event`]s (state changes, faults) are
+/// kept for [`DriveHandle::take_events`] (the newest
+/// [`DRIVE_EVENTS_KEPT`]).
+#[derive(Debug)]
+pub struct DriveHandle {
+    master: Master,
+    node: NodeId,
+    session: Session,
+    pdos: Option<Events>,
+    log: VecDeque<(Instant, Event)>,
+}
+
+impl DriveHandle {
+    /// Runs `session` (made or kept by the caller) on `node`. When the
+    /// session has a statusword TPDO, the handle listens to the master's
+    /// events for it.
+    pub fn new(master: Master, node: NodeId, session: Session) -> DriveHandle {
+        let pdos = session.config().statusword_pdo.map(|_| master.events());
+        DriveHandle {
+            master,
+            node,
+            session,
+            pdos,
+            log: VecDeque::new(),
+        }
+    }
+
+    /// The events since the last call (at most [`DRIVE_EVENTS_KEPT`], the
+    /// newest), each with the time it was seen.
+    pub fn take_events(&mut self) -> Vec<(Instant, Event)> {
+        self.log.drain(..).collect()
+    }
+
+    /// Runs one request (every other call is this one).
+    pub async fn request(&mut self, request: Request) -> Result<(), Cia402Error> {
+        let log = &mut self.log;
+        let mut on_event = |at: Instant, event: Event| {
+            if log.len() >= DRIVE_EVENTS_KEPT {
+                log.pop_front();
+            }
+            log.push_back((at, event));
+        };
+        self.master
+            .run_drive_request(
+                self.node,
+                &mut self.session,
+                request,
+                self.pdos.as_mut(),
+                &mut on_event,
+            )
+            .await
+    }
+
+    /// To Operation enabled from any state, resetting a fault.
+    pub async fn enable(&mut self) -> Result<(), Cia402Error> {
+        self.request(Request::Enable).await
+    }
+
+    /// Disable voltage, to Switch on disabled.
+    pub async fn disable(&mut self) -> Result<(), Cia402Error> {
+        self.request(Request::Disable).await
+    }
+
+    /// Quick stop, to Quick stop active (or Switch on disabled).
+    pub async fn quick_stop(&mut self) -> Result<(), Cia402Error> {
+        self.request(Request::QuickStop).await
+    }
+
+    /// Resets a fault; nothing to do outside the fault states.
+    pub async fn fault_reset(&mut self) -> Result<(), Cia402Error> {
+        self.request(Request::FaultReset).await
+    }
+
+    /// A profile-position move (absolute, relative, immediate per
+    /// `options`), until target reached.
+    pub async fn move_to(&mut self, target: i32, options: Move) -> Result<(), Cia402Error> {
+        self.request(Request::Move { target, options }).await
+    }
+
+    /// Profile velocity: `target` to 0x60FF, until target reached.
+    pub async fn velocity(&mut self, target: i32) -> Result<(), Cia402Error> {
+        self.request(Request::Velocity(target)).await
+    }
+
+    /// Homing with `method` (0x6098; `None`: the drive's), until homing
+    /// attained.
+    pub async fn home(&mut self, method: Option<i8>) -> Result<(), Cia402Error> {
+        self.request(Request::Home(method)).await
+    }
+
+    /// Profile velocity, acceleration and deceleration (0x6081, 0x6083,
+    /// 0x6084) for the next moves.
+    pub async fn set_profile(
+        &mut self,
+        velocity: u32,
+        acceleration: u32,
+        deceleration: u32,
+    ) -> Result<(), Cia402Error> {
+        let request = Request::Profile {
+            velocity,
+            acceleration,
+            deceleration,
+        };
+        self.request(request).await
+    }
+
+    /// One cyclic synchronous position target (0x607A, mode 8 first when
+    /// not set).
+    pub async fn csp_target(&mut self, target: i32) -> Result<(), Cia402Error> {
+        self.request(Request::CspTarget(target)).await
+    }
+
+    /// A fresh statusword.
+    pub async fn statusword(&mut self) -> Result<Statusword, Cia402Error> {
+        self.request(Request::Statusword).await?;
+        Ok(self.session.drive().statusword().unwrap_or(Statusword(0)))
+    }
+
+    /// The state of the last statusword seen.
+    pub fn state(&self) -> Option<State> {
+        self.session.drive().state()
+    }
+
+    /// The session (its drive, table and configuration).
+    pub fn session(&self) -> &Session {
+        &self.session
+    }
+
+    /// The master.
+    pub fn master(&self) -> &Master {
+        &self.master
+    }
+
+    /// The node.
+    pub fn node(&self) -> NodeId {
+        self.node
+    }
+}

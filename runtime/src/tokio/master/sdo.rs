@@ -1,0 +1,416 @@
+//! The SDO calls of the tokio [`Master`]: raw and typed transfers, and the
+//! PDO configuration over them.
+
+use std::vec::Vec;
+
+use ::tokio::sync::oneshot;
+
+use super::{Error, Master, SdoWaiter, Shared};
+use crate::blocking::{DriveError, Transfer, Upload, encode, give_up, visible_string};
+use crate::od::{self, Entry, NodeId};
+use crate::pdo::PdoConfig;
+use crate::pdo::blocking::{PdoConfigError, SdoAccess, run_steps};
+use crate::sdo::client::Method;
+use crate::sdo::typed;
+
+/// Ends the transfer of a call that did not see its end (dropped, or past
+/// its bound): aborts it on the core and wakes the driver to send the
+/// abort. `None` when the transfer had already ended (its result is in the
+/// call's channel).
+fn abandon(shared: &Shared, node: NodeId, id: u64, why: DriveError) -> Option<Error> {
+    let mut state = shared.lock();
+    if state.sdo.get(&node).is_none_or(|w| w.id != id) {
+        return None;
+    }
+    state.sdo.remove(&node);
+    let error = give_up(state.core.sdo_or_default(node), why);
+    drop(state);
+    shared.wake.notify_one();
+    Some(error)
+}
+
+/// Abandons the transfer when the call's future is dropped before its end.
+struct Guard<'a> {
+    shared: &'a Shared,
+    node: NodeId,
+    id: u64,
+    armed: bool,
+}
+
+impl Drop for Guard<'_> {
+    fn drop(&mut self) {
+        if self.armed {
+            abandon(self.shared, self.node, self.id, DriveError::Stopped);
+        }
+    }
+}
+
+impl Master {
+    async fn transfer(
+        &self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        transfer: Transfer<'_>,
+    ) -> Result<Upload, Error> {
+        let turn = {
+            let mut state = self.shared.lock();
+            state.running()?;
+            state.turns.entry(node).or_default().clone()
+        };
+        let _turn = turn.lock_owned().await;
+        let (mut reply, deadline, id) = {
+            let mut state = self.shared.lock();
+            state.running()?;
+            let now = self.shared.now();
+            let client = state.core.sdo_or_default(node);
+            transfer.start(client, now, index, sub)?;
+            let deadline = now + transfer.bound(client.config());
+            let (tx, rx) = oneshot::channel();
+            let id = state.next_id();
+            let waiter = SdoWaiter {
+                id,
+                index,
+                sub,
+                reply: tx,
+            };
+            state.sdo.insert(node, waiter);
+            (rx, deadline, id)
+        };
+        self.shared.wake.notify_one();
+        let mut guard = Guard {
+            shared: &self.shared,
+            node,
+            id,
+            armed: true,
+        };
+        let wake = ::tokio::time::Instant::from_std(self.shared.clock.to_std(deadline));
+        let result = ::tokio::select! {
+            result = &mut reply => Some(result),
+            () = ::tokio::time::sleep_until(wake) => None,
+        };
+        guard.armed = false;
+        let result = match result {
+            Some(result) => result.ok(),
+            None => match abandon(&self.shared, node, id, DriveError::Deadline) {
+                Some(error) => return Err(error),
+                None => reply.try_recv().ok(),
+            },
+        };
+        // A dropped sender: the driver stopped.
+        result.unwrap_or_else(|| Err(Error::Io(self.shared.lock().stopped_error())))
+    }
+
+    /// Reads (index, sub) of `node` with [`Method::Auto`]. A node without
+    /// an SDO client gets one on its default channel.
+    pub async fn upload(&self, node: NodeId, index: u16, sub: u8) -> Result<Vec<u8>, Error> {
+        self.upload_with(node, index, sub, Method::Auto).await
+    }
+
+    /// Reads (index, sub) of `node` with `method`.
+    pub async fn upload_with(
+        &self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        method: Method,
+    ) -> Result<Vec<u8>, Error> {
+        self.transfer(node, index, sub, Transfer::Upload(method))
+            .await
+            .map(|upload| upload.data)
+    }
+
+    /// Writes `data` to (index, sub) of `node` with [`Method::Auto`].
+    pub async fn download(
+        &self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        data: &[u8],
+    ) -> Result<(), Error> {
+        self.download_with(node, index, sub, data, Method::Auto)
+            .await
+    }
+
+    /// Writes `data` to (index, sub) of `node` with `method`.
+    pub async fn download_with(
+        &self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        data: &[u8],
+        method: Method,
+    ) -> Result<(), Error> {
+        self.transfer(node, index, sub, Transfer::Download(data, method))
+            .await
+            .map(drop)
+    }
+
+    /// Reads entry `E` of `node`:
+    ///
+    /// ```no_run
+    /// use eds2rust_runtime::od::{access, DataType, Entry, NodeId};
+    /// struct HeartbeatTime;
+    /// impl Entry for HeartbeatTime {
+    ///     const INDEX: u16 = 0x1017;
+    ///     const SUBINDEX: u8 = 0;
+    ///     const NAME: &'static str = "Producer heartbeat time";
+    ///     const DATA_TYPE: DataType = DataType::Unsigned16;
+    ///     const PDO_MAPPABLE: bool = false;
+    ///     type Access = access::Rw;
+    ///     type Value = u16;
+    /// }
+    /// async fn f(m: &eds2rust_runtime::tokio::Master, node: NodeId) {
+    ///     let ms: u16 = m.read::<HeartbeatTime>(node).await.unwrap();
+    ///     m.write::<HeartbeatTime>(node, ms * 2).await.unwrap();
+    /// }
+    /// ```
+    ///
+    /// Reading a write-only entry does not compile:
+    ///
+    /// ```compile_fail
+    /// use eds2rust_runtime::od::{access, DataType, Entry, NodeId};
+    /// struct Command;
+    /// impl Entry for Command {
+    ///     const INDEX: u16 = 0x2000;
+    ///     const SUBINDEX: u8 = 0;
+    ///     const NAME: &'static str = "Command";
+    ///     const DATA_TYPE: DataType = DataType::Unsigned8;
+    ///     const PDO_MAPPABLE: bool = false;
+    ///     type Access = access::Wo;
+    ///     type Value = u8;
+    /// }
+    /// async fn f(m: &eds2rust_runtime::tokio::Master, node: NodeId) {
+    ///     let _ = m.read::<Command>(node).await;
+    /// }
+    /// ```
+    pub async fn read<E>(&self, node: NodeId) -> Result<E::Value, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::Scalar,
+    {
+        self.read_sub::<E>(node, E::SUBINDEX).await
+    }
+
+    /// Writes `value` to entry `E` of `node`. Writing a read-only entry
+    /// does not compile:
+    ///
+    /// ```compile_fail
+    /// use eds2rust_runtime::od::{access, DataType, Entry, NodeId};
+    /// struct DeviceType;
+    /// impl Entry for DeviceType {
+    ///     const INDEX: u16 = 0x1000;
+    ///     const SUBINDEX: u8 = 0;
+    ///     const NAME: &'static str = "Device type";
+    ///     const DATA_TYPE: DataType = DataType::Unsigned32;
+    ///     const PDO_MAPPABLE: bool = false;
+    ///     type Access = access::Ro;
+    ///     type Value = u32;
+    /// }
+    /// async fn f(m: &eds2rust_runtime::tokio::Master, node: NodeId) {
+    ///     let _ = m.write::<DeviceType>(node, 1).await;
+    /// }
+    /// ```
+    pub async fn write<E>(&self, node: NodeId, value: E::Value) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::Scalar,
+    {
+        self.write_sub::<E>(node, E::SUBINDEX, value).await
+    }
+
+    /// Reads the bytes of a string, DOMAIN or other byte-valued entry.
+    pub async fn read_bytes<E>(&self, node: NodeId) -> Result<Vec<u8>, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::ByteValue,
+    {
+        self.upload(node, E::INDEX, E::SUBINDEX).await
+    }
+
+    /// Reads a VISIBLE_STRING entry: the text before the first NUL.
+    pub async fn read_string<E>(&self, node: NodeId) -> Result<std::string::String, Error>
+    where
+        E: Entry<Value = od::bytes::VisibleString>,
+        E::Access: od::Read,
+    {
+        visible_string(self.upload(node, E::INDEX, E::SUBINDEX).await?)
+    }
+
+    /// Writes the bytes of a string, DOMAIN or other byte-valued entry.
+    pub async fn write_bytes<E>(&self, node: NodeId, data: &[u8]) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::ByteValue,
+    {
+        self.download(node, E::INDEX, E::SUBINDEX, data).await
+    }
+
+    /// Reads element `at` of an ARRAY of `node`: the run-time form of
+    /// [`Self::read`] with `A<SUB>`.
+    pub async fn read_at<A>(&self, node: NodeId, at: od::Element<A>) -> Result<A::Value, Error>
+    where
+        A: od::Array,
+        A::Access: od::Read,
+        A::Value: od::Scalar,
+    {
+        self.read_sub::<A>(node, at.subindex()).await
+    }
+
+    /// Writes `value` to element `at` of an ARRAY of `node`.
+    pub async fn write_at<A>(
+        &self,
+        node: NodeId,
+        at: od::Element<A>,
+        value: A::Value,
+    ) -> Result<(), Error>
+    where
+        A: od::Array,
+        A::Access: od::Write,
+        A::Value: od::Scalar,
+    {
+        self.write_sub::<A>(node, at.subindex(), value).await
+    }
+
+    /// Reads the bytes of element `at` of a byte-valued ARRAY (DOMAIN,
+    /// strings).
+    pub async fn read_bytes_at<A>(&self, node: NodeId, at: od::Element<A>) -> Result<Vec<u8>, Error>
+    where
+        A: od::Array,
+        A::Access: od::Read,
+        A::Value: od::ByteValue,
+    {
+        self.upload(node, A::INDEX, at.subindex()).await
+    }
+
+    /// Writes the bytes of element `at` of a byte-valued ARRAY.
+    pub async fn write_bytes_at<A>(
+        &self,
+        node: NodeId,
+        at: od::Element<A>,
+        data: &[u8],
+    ) -> Result<(), Error>
+    where
+        A: od::Array,
+        A::Access: od::Write,
+        A::Value: od::ByteValue,
+    {
+        self.download(node, A::INDEX, at.subindex(), data).await
+    }
+
+    /// Typed read of sub `sub` of `E`'s object.
+    async fn read_sub<E>(&self, node: NodeId, sub: u8) -> Result<E::Value, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::Scalar,
+    {
+        let upload = self
+            .transfer(node, E::INDEX, sub, Transfer::Upload(Method::Auto))
+            .await?;
+        let mut state = self.shared.lock();
+        let strict = state.core.sdo_or_default(node).config().strict_lengths;
+        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)?;
+        if let Some(note) = note {
+            typed::keep(&mut state.notes, (node, note));
+        }
+        Ok(value)
+    }
+
+    /// Typed write of sub `sub` of `E`'s object.
+    async fn write_sub<E>(&self, node: NodeId, sub: u8, value: E::Value) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::Scalar,
+    {
+        let (buf, len) = encode::<E>(value)?;
+        self.download(node, E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
+            .await
+    }
+
+    /// Configures a PDO of `node` as [`crate::pdo::blocking::configure_pdo`]
+    /// does: the same check first (nothing is sent for an invalid
+    /// configuration), the writes in the CiA 301 order, the read-backs, and
+    /// the same errors.
+    ///
+    /// The steps are those of the blocking implementation itself: it is
+    /// replayed over the answers of the transfers done so far, each run
+    /// telling the next transfer to do, until it ends.
+    pub async fn configure_pdo(
+        &self,
+        node: NodeId,
+        config: &PdoConfig<'_>,
+    ) -> Result<(), PdoConfigError> {
+        let mut replay = Replay::default();
+        loop {
+            replay.at = 0;
+            let result = run_steps(&mut replay, config);
+            let Some(request) = replay.next.take() else {
+                return result;
+            };
+            let answer = match request {
+                Request::Download { index, sub, data } => self
+                    .download(node, index, sub, &data)
+                    .await
+                    .map(|()| Vec::new()),
+                Request::Upload { index, sub } => self.upload(node, index, sub).await,
+            };
+            replay.answers.push(answer);
+        }
+    }
+}
+
+/// A transfer the PDO configuration asks for.
+enum Request {
+    Download { index: u16, sub: u8, data: Vec<u8> },
+    Upload { index: u16, sub: u8 },
+}
+
+/// The answers of the transfers done so far, for a replay of
+/// [`run_steps`]; the first transfer beyond them is recorded in `next`
+/// (and answered with a placeholder error that ends that run).
+#[derive(Default)]
+struct Replay {
+    answers: Vec<Result<Vec<u8>, Error>>,
+    at: usize,
+    next: Option<Request>,
+}
+
+impl Replay {
+    fn answer(&mut self, request: impl FnOnce() -> Request) -> Result<Vec<u8>, Error> {
+        let i = self.at;
+        self.at += 1;
+        match self.answers.get_mut(i) {
+            Some(Ok(data)) => Ok(data.clone()),
+            // A failed transfer ends the steps: it is the last answer and
+            // is replayed once, by the run that returns.
+            Some(failed) => core::mem::replace(failed, Err(Error::Busy)),
+            None => {
+                if self.next.is_none() {
+                    self.next = Some(request());
+                }
+                Err(Error::Busy)
+            }
+        }
+    }
+}
+
+impl SdoAccess for Replay {
+    fn download(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), Error> {
+        self.answer(|| Request::Download {
+            index,
+            sub,
+            data: data.to_vec(),
+        })
+        .map(drop)
+    }
+
+    fn upload(&mut self, index: u16, sub: u8) -> Result<Vec<u8>, Error> {
+        self.answer(|| Request::Upload { index, sub })
+    }
+}

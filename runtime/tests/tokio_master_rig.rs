@@ -1,0 +1,235 @@
+//! The rig of the tokio master tests (`tokio_master.rs`,
+//! `tokio_master_events.rs`): the virtual bus under tokio's paused clock,
+//! the master and its driver task, a device assembled from the runtime's
+//! sans-IO services (SDO server, NMT slave, heartbeat producer, LSS slave,
+//! a TPDO transmitter) served on a task, and a monitor port that sees
+//! every frame. Compiled on its own it holds no tests.
+#![cfg(feature = "tokio")]
+#![allow(dead_code)]
+
+use std::time::Duration;
+
+use eds2rust_runtime::heartbeat::HeartbeatProducer;
+use eds2rust_runtime::lss::{BitRate, BitTiming, Identity, LssSlave};
+use eds2rust_runtime::master::{self, MasterEvent};
+use eds2rust_runtime::nmt::NmtSlave;
+use eds2rust_runtime::od::{
+    self, AccessRight, DataType, Entry, NodeId, PdoDirection, PdoLengthError, access,
+};
+use eds2rust_runtime::pdo::{PdoTransmitter, TransmitterConfig};
+use eds2rust_runtime::sdo::Channel;
+use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
+use eds2rust_runtime::tokio::{self as driver, Deadline, Events, Master};
+use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
+use eds2rust_runtime::{CanId, Frame, Instant, Service};
+use tokio::task::JoinHandle;
+
+pub const DEVICE: u8 = 0x20;
+pub const IDENTITY: Identity = Identity::new(0x0000_02A5, 0x1234, 7, 0xBEEF);
+
+pub fn node(id: u8) -> NodeId {
+    NodeId::new(id).unwrap()
+}
+
+pub fn frame(id: u16, data: &[u8]) -> Frame {
+    Frame::new(CanId::Standard(id), data).unwrap()
+}
+
+macro_rules! entry {
+    ($name:ident, $index:literal, $sub:literal, $ty:ident, $access:ident, $value:ty) => {
+        pub struct $name;
+        impl Entry for $name {
+            const INDEX: u16 = $index;
+            const SUBINDEX: u8 = $sub;
+            const NAME: &'static str = stringify!($name);
+            const DATA_TYPE: DataType = DataType::$ty;
+            const PDO_MAPPABLE: bool = false;
+            type Access = access::$access;
+            type Value = $value;
+        }
+    };
+}
+
+entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
+entry!(
+    DeviceName,
+    0x1008,
+    0,
+    VisibleString,
+    Ro,
+    od::bytes::VisibleString
+);
+entry!(Blob, 0x2100, 0, Domain, Rw, od::bytes::Domain);
+
+/// The device's TPDO1: a 16-bit counter at 0x2001:00.
+#[derive(Debug, PartialEq)]
+pub struct Counter(pub u16);
+
+impl od::Pdo for Counter {
+    const DIRECTION: PdoDirection = PdoDirection::Tpdo;
+    const NUMBER: u16 = 1;
+    const COMMUNICATION_INDEX: u16 = 0x1800;
+    const MAPPING_INDEX: u16 = 0x1A00;
+    const LEN: usize = 2;
+    const MAPPING: &'static [u32] = &[0x2001_0010];
+    fn default_cob_id(node_id: NodeId) -> Option<u32> {
+        Some(0x180 + u32::from(node_id.get()))
+    }
+    fn decode(data: &[u8]) -> Result<Self, PdoLengthError> {
+        let bytes = eds2rust_runtime::pdo::layout::load::<2>(data)?;
+        Ok(Counter(u16::from_le_bytes(*bytes)))
+    }
+    fn encode_into(&self, out: &mut [u8; 8]) -> usize {
+        out[..2].copy_from_slice(&self.0.to_le_bytes());
+        2
+    }
+}
+
+/// The device: SDO server, NMT slave, heartbeat every 50 ms, LSS slave,
+/// TPDO1 (a counter, sent at every SYNC and counted up after it).
+pub struct Device {
+    sdo: SdoServer<MemoryStore>,
+    nmt: NmtSlave,
+    heartbeat: HeartbeatProducer,
+    lss: LssSlave,
+    tpdo: PdoTransmitter,
+    counter: u16,
+}
+
+impl Device {
+    fn new() -> Device {
+        let id = node(DEVICE);
+        let mut store = MemoryStore::new();
+        store.insert_fixed(0x1017, 0, AccessRight::Rw, &50u16.to_le_bytes());
+        store.insert(0x1008, 0, AccessRight::Ro, b"eds2rust test device");
+        store.insert(0x2100, 0, AccessRight::Rw, &[0xA5; 100]);
+        store.insert_fixed(0x1800, 1, AccessRight::Rw, &0x1A0u32.to_le_bytes());
+        store.insert_fixed(0x1800, 2, AccessRight::Rw, &[0xFF]);
+        store.insert_fixed(0x1800, 5, AccessRight::Rw, &[0; 2]);
+        store.insert_fixed(0x1A00, 0, AccessRight::Rw, &[0]);
+        store.insert_fixed(0x1A00, 1, AccessRight::Rw, &[0; 4]);
+        let mut tpdo = PdoTransmitter::new(TransmitterConfig::new(0x1A0, 1)).unwrap();
+        tpdo.set_data(Instant::ZERO, &0u16.to_le_bytes()).unwrap();
+        Device {
+            sdo: SdoServer::new(ServerConfig::new(Channel::default_for(id)), store),
+            nmt: NmtSlave::new(id),
+            heartbeat: HeartbeatProducer::new(id, Duration::from_millis(50)),
+            lss: LssSlave::new(IDENTITY, Some(id), BitTiming::standard(BitRate::Kbit500)),
+            tpdo,
+            counter: 0,
+        }
+    }
+}
+
+impl Service for Device {
+    type Event = ();
+    fn handle_frame(&mut self, now: Instant, frame: &Frame) {
+        self.sdo.handle_frame(now, frame);
+        self.nmt.handle_frame(now, frame);
+        while self.nmt.poll_event().is_some() {}
+        self.heartbeat.set_state(self.nmt.state());
+        self.lss.handle_frame(now, frame);
+        while self.lss.poll_event().is_some() {}
+        self.tpdo.handle_frame(now, frame);
+        if frame.cob_id() == Some(0x080) {
+            // The value of the next SYNC.
+            self.counter = self.counter.wrapping_add(1);
+            let _ = self.tpdo.set_data(now, &self.counter.to_le_bytes());
+        }
+    }
+    fn handle_timeout(&mut self, now: Instant) {
+        if self.sdo.poll_timeout().is_some_and(|at| at <= now) {
+            self.sdo.handle_timeout(now);
+        }
+        if self.heartbeat.poll_timeout().is_some_and(|at| at <= now) {
+            self.heartbeat.handle_timeout(now);
+        }
+    }
+    fn poll_transmit(&mut self) -> Option<Frame> {
+        self.sdo
+            .poll_transmit()
+            .or_else(|| self.heartbeat.poll_transmit())
+            .or_else(|| self.lss.poll_transmit())
+            .or_else(|| self.tpdo.poll_transmit())
+    }
+    fn poll_event(&mut self) -> Option<()> {
+        while self.sdo.poll_event().is_some() {}
+        None
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        eds2rust_runtime::time::earliest(self.sdo.poll_timeout(), self.heartbeat.poll_timeout())
+    }
+}
+
+/// Serves the device on `port` until the task is aborted.
+pub fn spawn_device(mut port: VirtualPort) -> JoinHandle<()> {
+    tokio::spawn(async move {
+        let clock = driver::clock();
+        let mut device = Device::new();
+        device.nmt.boot_complete();
+        device.heartbeat.set_state(device.nmt.state());
+        device.heartbeat.start(driver::now(&clock));
+        let pending = std::future::pending();
+        let _ = driver::serve(
+            &mut port,
+            &clock,
+            &mut device,
+            pending,
+            Deadline::NEVER,
+            |()| {},
+        )
+        .await;
+    })
+}
+
+/// The bus, the master, its driver task, the device task and a monitor.
+pub struct Rig {
+    pub bus: VirtualBus,
+    pub master: Master,
+    pub events: Events,
+    pub driver: JoinHandle<std::io::Result<()>>,
+    pub device: JoinHandle<()>,
+    pub monitor: VirtualPort,
+}
+
+impl Rig {
+    pub async fn new(configure: impl FnOnce(&mut master::Master)) -> Rig {
+        let bus = VirtualBus::new();
+        let monitor = bus.attach();
+        let device = spawn_device(bus.attach());
+        let mut core = master::Master::new(node(1), Duration::from_millis(100));
+        configure(&mut core);
+        let (master, driver) = Master::new(bus.attach(), core);
+        let events = master.events();
+        let driver = tokio::spawn(driver.run());
+        master.start().await.unwrap();
+        Rig {
+            bus,
+            master,
+            events,
+            driver,
+            device,
+            monitor,
+        }
+    }
+
+    /// The frames the monitor saw since the last call.
+    pub fn seen(&self) -> Vec<Frame> {
+        std::iter::from_fn(|| self.monitor.try_recv()).collect()
+    }
+
+    /// Waits (in virtual time) for the first event `pick` takes.
+    pub async fn wait_for<T>(&mut self, mut pick: impl FnMut(&MasterEvent) -> Option<T>) -> T {
+        let within = Duration::from_secs(10);
+        tokio::time::timeout(within, async {
+            loop {
+                let event = self.events.next().await.expect("the driver stopped");
+                if let Some(value) = pick(&event) {
+                    return value;
+                }
+            }
+        })
+        .await
+        .expect("no such event within 10 s")
+    }
+}
