@@ -74,26 +74,45 @@ pub struct Requirement {
     pub name: &'static str,
     /// How the operation uses it.
     pub usage: Use,
+    /// What [`assert_supported`] says when a table lacks it (a compile-time
+    /// panic takes no formatted message).
+    pub missing: &'static str,
 }
 
-const fn write(index: u16, name: &'static str) -> Requirement {
-    Requirement {
-        index,
-        name,
-        usage: Use::Write,
-    }
+/// A requirement: `need!(write, 0x60FF, "Target velocity")`.
+macro_rules! need {
+    ($usage:ident, $index:literal, $name:literal) => {
+        Requirement {
+            index: $index,
+            name: $name,
+            usage: need!(@ $usage),
+            missing: concat!(
+                "this device has no ",
+                need!(@text $usage),
+                " ",
+                stringify!($index),
+                " ",
+                $name,
+                ", which an operation of this assertion needs"
+            ),
+        }
+    };
+    (@ write) => {
+        Use::Write
+    };
+    (@text write) => {
+        "writable"
+    };
+    (@text read) => {
+        "readable"
+    };
+    (@ read) => {
+        Use::Read
+    };
 }
 
-const fn read(index: u16, name: &'static str) -> Requirement {
-    Requirement {
-        index,
-        name,
-        usage: Use::Read,
-    }
-}
-
-const MODES: Requirement = write(object::MODES_OF_OPERATION, "Modes of operation");
-const TARGET_POSITION: Requirement = write(object::TARGET_POSITION, "Target position");
+const MODES: Requirement = need!(write, 0x6060, "Modes of operation");
+const TARGET_POSITION: Requirement = need!(write, 0x607A, "Target position");
 
 impl Operation {
     /// Every operation.
@@ -121,17 +140,17 @@ impl Operation {
     /// The objects the operation needs.
     pub const fn requirements(self) -> &'static [Requirement] {
         const STATE_MACHINE: &[Requirement] = &[
-            write(object::CONTROLWORD, "Controlword"),
-            read(object::STATUSWORD, "Statusword"),
+            need!(write, 0x6040, "Controlword"),
+            need!(read, 0x6041, "Statusword"),
         ];
         const PROFILE_POSITION: &[Requirement] = &[MODES, TARGET_POSITION];
         const PROFILE_VELOCITY: &[Requirement] =
-            &[MODES, write(object::TARGET_VELOCITY, "Target velocity")];
-        const HOMING: &[Requirement] = &[MODES, write(object::HOMING_METHOD, "Homing method")];
+            &[MODES, need!(write, 0x60FF, "Target velocity")];
+        const HOMING: &[Requirement] = &[MODES, need!(write, 0x6098, "Homing method")];
         const MOTION_PROFILE: &[Requirement] = &[
-            write(object::PROFILE_VELOCITY, "Profile velocity"),
-            write(object::PROFILE_ACCELERATION, "Profile acceleration"),
-            write(object::PROFILE_DECELERATION, "Profile deceleration"),
+            need!(write, 0x6081, "Profile velocity"),
+            need!(write, 0x6083, "Profile acceleration"),
+            need!(write, 0x6084, "Profile deceleration"),
         ];
         match self {
             Operation::StateMachine => STATE_MACHINE,
@@ -176,8 +195,8 @@ impl Operation {
 pub const fn assert_supported(objects: &[ObjectInfo], operations: &[Operation]) {
     let mut i = 0;
     while i < operations.len() {
-        if operations[i].check(objects).is_err() {
-            panic!("{}", operations[i].name());
+        if let Err(e) = operations[i].check(objects) {
+            panic!("{}", e.requirement.missing);
         }
         i += 1;
     }
