@@ -12,6 +12,10 @@
 //!   examples run it on a bus in a thread.
 //! - A [`Behaviour`] adds what the device does: `models` (feature
 //!   `seed-models`) has the three seed devices, written from their manuals.
+//! - [`cia402`] is a generic CiA 402 drive behaviour for any table with a
+//!   controlword and a statusword (docs/cia402-sim.md).
+//! - `file` (feature `files`) reads the table of a device from an
+//!   EDS/DCF/YAML file at run time, for devices without generated code.
 //! - [`bench`](mod@bench) runs a master and a device in virtual time, for tests.
 //! - [`harness`] runs a simulator and a master on the virtual bus (or, with
 //!   the feature `socketcan`, on a SocketCAN interface), with an optional
@@ -25,7 +29,10 @@
 
 pub mod behaviour;
 pub mod bench;
+pub mod cia402;
 pub mod device;
+#[cfg(feature = "files")]
+pub mod file;
 pub mod harness;
 #[cfg(feature = "seed-models")]
 pub mod models;

@@ -168,6 +168,56 @@ impl ObjectTable {
         (value.len() <= 8).then(|| raw_le(value))
     }
 
+    /// The current value of a numeric entry as a signed integer, whatever
+    /// its type: integers sign-extended per the type (UNSIGNED64 above
+    /// `i64::MAX` saturates), reals rounded. `None` when the table lacks
+    /// the entry or it is not a number. For code that works on any table
+    /// (the generic [`Cia402`](crate::cia402::Cia402)).
+    pub fn get_int(&self, index: u16, sub: u8) -> Option<i64> {
+        let slot = self.slots.get(&(index, sub))?;
+        match number(slot.info.data_type, &slot.value)? {
+            Number::Int(v) => Some(v.clamp(i128::from(i64::MIN), i128::from(i64::MAX)) as i64),
+            Number::Real(v) if v.is_finite() => Some(v.round() as i64),
+            Number::Real(_) => None,
+        }
+    }
+
+    /// Stores `value` into a numeric entry of any type, saturated to the
+    /// type's range (reals converted); returns whether the value changed.
+    /// [`SetError::Missing`] when the table lacks the entry, and
+    /// [`SetError::Length`] (expected 0) for an entry that is not a number.
+    pub fn set_int(&mut self, index: u16, sub: u8, value: i64) -> Result<bool, SetError> {
+        let info = *self
+            .info(index, sub)
+            .ok_or(SetError::Missing { index, sub })?;
+        let data_type = info.data_type;
+        let not_a_number = SetError::Length {
+            index,
+            sub,
+            expected: 0,
+            actual: 8,
+        };
+        let size = data_type.size().ok_or(not_a_number)?;
+        let raw: u64 = match data_type {
+            DataType::Real32 => u64::from((value as f32).to_bits()),
+            DataType::Real64 => (value as f64).to_bits(),
+            DataType::Boolean => u64::from(value != 0),
+            DataType::TimeOfDay | DataType::TimeDifference => return Err(not_a_number),
+            t if t.is_signed() => {
+                let bits = 8 * size as u32;
+                let (min, max) = (-(1i64 << (bits - 1).min(63)), i64::MAX >> (64 - bits));
+                value.clamp(min, max) as u64
+            }
+            _ => {
+                let bits = 8 * size as u32;
+                let max = u64::MAX >> (64 - bits);
+                (value.max(0) as u64).min(max)
+            }
+        };
+        let bytes = raw.to_le_bytes();
+        self.set_raw(index, sub, &bytes[..size.min(8)])
+    }
+
     /// The typed value of a generated entry, whatever its access right (the
     /// device reads its own objects).
     pub fn value<E>(&self) -> Option<E::Value>

@@ -49,7 +49,6 @@
 
 mod factory;
 mod logic;
-mod motion;
 
 use std::time::Duration;
 
@@ -61,9 +60,9 @@ use eds2rust_runtime::lss::BitRate;
 use eds2rust_runtime::od::{Entry, NodeId};
 use eds2rust_runtime::sdo::abort::AbortCode;
 
+use crate::cia402::profiler::Profiler;
 use crate::{Behaviour, Context, Device, DeviceConfig};
 pub use factory::Variant;
-use motion::Profiler;
 
 /// The node id at delivery (11.2 Quickstart: 40).
 pub const NODE: NodeId = match NodeId::new(DEFAULT_NODE_ID) {

@@ -12,9 +12,9 @@ use eds2rust_runtime::cia402::{
 };
 
 use super::factory::{self, RAMP_MAX};
-use super::motion::{Goal, Profiler};
 use super::{POSITION_WINDOW_TIME, STO_LATCH_TIME, ZimmerAcs, ZimmerAcsEvent};
 use crate::Context;
+use crate::cia402::profiler::{Goal, Profiler};
 
 type Ctx<'a, 'b> = &'a mut Context<'b, ZimmerAcsEvent>;
 

@@ -1,19 +1,20 @@
-//! The trajectory generator of the simulated axis: a trapezoidal velocity
-//! profile computed on line, so that a target can change during a move
-//! ("change immediately", controlword bit 5) and a halt or quick stop can
-//! brake from any speed. Units: µm, µm/s, µm/s² (the manual's position unit
-//! is µm, its velocity unit mm/s, 15.5).
+//! The trajectory generator of the simulated drives: a trapezoidal
+//! velocity profile computed on line, so that a target can change during a
+//! move ("change immediately", controlword bit 5) and a halt or quick stop
+//! can brake from any speed; and a ramp to a target velocity (profile
+//! velocity mode). Units are the caller's: a position unit, that unit per
+//! second and per second squared (the generic [`Cia402`](super::Cia402)
+//! uses the device's own position units; the Zimmer model µm).
 //!
-//! The manual does not describe the profile shape; CiA 402 profile position
-//! mode with linear ramps (a trapezoid) is what a ball-screw axis of this
-//! kind runs, so that is what is modelled.
+//! CiA 402 profile position mode with linear ramps (a trapezoid) is what
+//! is modelled; jerk limits and the motion profile type 0x6086 are not.
 
 /// The longest integration step, in seconds of model time.
 const MAX_STEP_S: f64 = 0.001;
 /// The most integration steps one call runs (larger steps beyond that).
 const MAX_STEPS: u32 = 100_000;
-/// Closer than this (µm) to the target counts as there.
-const ARRIVAL_UM: f64 = 0.01;
+/// Closer than this (position units) to the target counts as there.
+const ARRIVAL: f64 = 0.01;
 
 /// Where the generator is heading.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -21,18 +22,28 @@ pub(crate) enum Goal {
     /// Move to `target` with at most `velocity`, accelerating with
     /// `acceleration` and braking with `deceleration`.
     Target {
-        /// Absolute target (µm).
+        /// Absolute target (units).
         target: f64,
-        /// Profile velocity (µm/s, > 0).
+        /// Profile velocity (units/s, > 0).
         velocity: f64,
-        /// Profile acceleration (µm/s², > 0).
+        /// Profile acceleration (units/s², > 0).
         acceleration: f64,
-        /// Profile deceleration (µm/s², > 0).
+        /// Profile deceleration (units/s², > 0).
         deceleration: f64,
     },
-    /// Brake to standstill with `deceleration` (µm/s², > 0).
+    /// Brake to standstill with `deceleration` (units/s², > 0).
     Stop {
-        /// Deceleration (µm/s²).
+        /// Deceleration (units/s²).
+        deceleration: f64,
+    },
+    /// Run at `velocity` (signed, units/s), speeding up with `acceleration`
+    /// and slowing down (towards 0 or through it) with `deceleration`.
+    Velocity {
+        /// Target velocity (units/s).
+        velocity: f64,
+        /// Acceleration (units/s², > 0).
+        acceleration: f64,
+        /// Deceleration (units/s², > 0).
         deceleration: f64,
     },
 }
@@ -40,9 +51,9 @@ pub(crate) enum Goal {
 /// The demand position and velocity the generator puts out.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub(crate) struct Profiler {
-    /// Demand position (µm).
+    /// Demand position (units).
     pub(crate) position: f64,
-    /// Demand velocity (µm/s, signed).
+    /// Demand velocity (units/s, signed).
     pub(crate) velocity: f64,
 }
 
@@ -62,7 +73,7 @@ impl Profiler {
 
     /// Runs the generator for `seconds` of model time towards `goal`;
     /// returns whether the goal was reached (target: there at rest; stop:
-    /// at rest).
+    /// at rest; velocity: at that velocity, still moving).
     pub(crate) fn run(&mut self, seconds: f64, goal: Goal) -> bool {
         if seconds.is_nan() || seconds <= 0.0 {
             return self.reached(goal);
@@ -71,8 +82,10 @@ impl Profiler {
             .ceil()
             .clamp(1.0, f64::from(MAX_STEPS));
         let h = seconds / steps;
+        // A velocity goal keeps moving once reached.
+        let ends = !matches!(goal, Goal::Velocity { .. });
         for _ in 0..steps as u32 {
-            if self.reached(goal) {
+            if ends && self.reached(goal) {
                 return true;
             }
             self.step(h, goal);
@@ -84,6 +97,7 @@ impl Profiler {
         match goal {
             Goal::Target { target, .. } => self.at_rest() && self.position == target,
             Goal::Stop { .. } => self.at_rest(),
+            Goal::Velocity { velocity, .. } => self.velocity == velocity,
         }
     }
 
@@ -100,6 +114,29 @@ impl Profiler {
                 self.position += (v + next) / 2.0 * h;
                 self.velocity = next;
             }
+            Goal::Velocity {
+                velocity,
+                acceleration,
+                deceleration,
+            } => {
+                let v = self.velocity;
+                // Speeding up (same sign, larger) uses the acceleration;
+                // slowing down or reversing the deceleration.
+                let speeding_up = v * velocity >= 0.0 && velocity.abs() > v.abs();
+                let rate = if speeding_up {
+                    acceleration
+                } else {
+                    deceleration
+                };
+                let dv = rate.max(f64::MIN_POSITIVE) * h;
+                let next = if (velocity - v).abs() <= dv {
+                    velocity
+                } else {
+                    v + dv * (velocity - v).signum()
+                };
+                self.position += (v + next) / 2.0 * h;
+                self.velocity = next;
+            }
             Goal::Target {
                 target,
                 velocity,
@@ -107,7 +144,7 @@ impl Profiler {
                 deceleration,
             } => {
                 let remaining = target - self.position;
-                if remaining.abs() <= ARRIVAL_UM && self.velocity.abs() <= deceleration * h {
+                if remaining.abs() <= ARRIVAL && self.velocity.abs() <= deceleration * h {
                     self.position = target;
                     self.velocity = 0.0;
                     return;
@@ -187,6 +224,29 @@ mod tests {
         q.run(0.4, to(40_000.0));
         assert!((q.velocity - 50_000.0).abs() < 1e-6);
         assert!((q.position - (2_500.0 + 0.3 * 50_000.0)).abs() < 1.0);
+    }
+
+    #[test]
+    fn a_velocity_goal_ramps_with_the_acceleration_and_holds() {
+        let goal = Goal::Velocity {
+            velocity: 1_000.0,
+            acceleration: 10_000.0,
+            deceleration: 20_000.0,
+        };
+        let mut p = Profiler::at(0.0);
+        // 0.1 s ramp (50 units), then 1000 units/s.
+        assert!(p.run(0.2, goal));
+        assert_eq!(p.velocity, 1_000.0);
+        assert!((p.position - (50.0 + 100.0)).abs() < 1.0);
+        let back = Goal::Velocity {
+            velocity: -1_000.0,
+            acceleration: 10_000.0,
+            deceleration: 20_000.0,
+        };
+        // Reversing: down to 0 with the deceleration (0.05 s), then up
+        // with the acceleration (0.1 s).
+        assert!(!p.run(0.14, back));
+        assert!(p.run(0.011, back));
     }
 
     #[test]
