@@ -358,9 +358,13 @@ fn od_upload_then_download_restores_a_changed_value() {
     ]
     .concat());
     let out = ok(&[&["od", "download"][..], &common, &[dcf.as_str()]].concat());
-    assert!(out.contains("0x6060 Modes of operation: ok 1\n"), "{out}");
+    // The DCF carries no YAML meaning, but the built-in CiA 301/402 ones.
     assert!(
-        out.contains("0x1800.5 TPDO1 communication parameter.Event timer: ok 0 (0x0000)\n"),
+        out.contains("0x6060 Modes of operation: ok 1 \"profile position\"\n"),
+        "{out}"
+    );
+    assert!(
+        out.contains("0x1800.5 TPDO1 communication parameter.Event timer: ok 0 (0x0000) = 0 ms\n"),
         "{out}"
     );
     assert!(
@@ -417,7 +421,7 @@ fn against_a_python_canopen_local_node() {
     );
     assert_eq!(
         out,
-        "0x6041 Statusword = 592 (0x0250)\n\
+        "0x6041 Statusword = 592 (0x0250) state \"switch on disabled\"; bits: \"voltage enabled\", \"switch on disabled\", \"remote\"\n\
          0x2000 Gear ratio = 12.5\n\
          0x1018 Identity object.Highest sub-index supported = 3 (0x03)\n\
          0x1018.1 Identity object.Vendor-ID = 3629 (0x00000E2D)\n\
@@ -430,7 +434,7 @@ fn against_a_python_canopen_local_node() {
     );
     assert_eq!(
         sdo("write", &["--od", &eds, "Modes of operation", "-3"]),
-        "0x6060 Modes of operation := -3\n"
+        "0x6060 Modes of operation := -3 \"manufacturer specific\"\n"
     );
     let program = write_file(&dir, "program.bin", &"0123456789".repeat(30));
     assert_eq!(
@@ -451,11 +455,14 @@ fn against_a_python_canopen_local_node() {
     sdo("write", &["--od", &eds, "0x6060", "1"]);
     let out = ok(&[&["od", "download"][..], &common, &[dcf.as_str()]].concat());
     assert!(
-        out.contains("0x1017 Producer heartbeat time: ok 1000 (0x03E8)\n"),
+        out.contains("0x1017 Producer heartbeat time: ok 1000 (0x03E8) = 1000 ms\n"),
         "{out}"
     );
     assert!(out.contains("0x2000 Gear ratio: ok 2.25\n"), "{out}");
-    assert!(out.contains("0x6060 Modes of operation: ok -3\n"), "{out}");
+    assert!(
+        out.contains("0x6060 Modes of operation: ok -3 \"manufacturer specific\"\n"),
+        "{out}"
+    );
     assert!(
         out.lines()
             .last()
