@@ -368,7 +368,9 @@ fn od_upload_then_download_restores_a_changed_value() {
         "{out}"
     );
     assert!(
-        out.contains("0x1800.1 TPDO1 communication parameter.COB-ID: ok 424 (0x000001A8)\n"),
+        out.contains(
+            "0x1800.1 TPDO1 communication parameter.COB-ID: ok 424 (0x000001A8) bits: \"CAN-ID\"=424\n"
+        ),
         "{out}"
     );
     let summary = out.lines().last().unwrap();
