@@ -1,7 +1,8 @@
 //! The `eds2rust` command line: check, dump, export and diff CANopen object
 //! dictionaries, generate their Rust and list its API; and talk to live
 //! nodes over SocketCAN (`sdo`, `nmt`, `scan`, `od upload|download`, `lss`:
-//! the `live` module, docs/live-bus.md).
+//! the `live` module, docs/live-bus.md); simulate a device from its file on
+//! SocketCAN (`sim`, docs/sim-cli.md).
 //!
 //! Exit status: 0 when no input has an error, 1 when one has, 2 on usage errors.
 //! `diff`: 0 without changes at the `--fail-on` level, 1 with, 2 on usage or
@@ -12,6 +13,7 @@
 mod decode;
 mod live;
 mod monitor;
+mod sim;
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -134,6 +136,12 @@ enum Command {
     /// stream, or a table of the nodes (--table), and a chart of PDO fields
     /// (--plot), until --duration ends or Ctrl-C.
     Monitor(monitor::MonitorArgs),
+    /// Simulates the device of an EDS/DCF file or YAML table on a SocketCAN
+    /// interface (docs/sim-cli.md): boot-up, SDO server, NMT, heartbeat,
+    /// PDOs, and a CiA 402 drive when the file is one; one line per NMT
+    /// change, SDO write and drive state change, until --duration ends or
+    /// Ctrl-C.
+    Sim(sim::SimArgs),
     /// Reads and writes objects of a live node by SDO (docs/live-bus.md).
     #[command(subcommand)]
     Sdo(live::SdoCommand),
@@ -232,6 +240,7 @@ fn main() -> ExitCode {
         | Command::Diff { read, .. } => read.options(),
         Command::Decode(_)
         | Command::Monitor(_)
+        | Command::Sim(_)
         | Command::Sdo(_)
         | Command::Nmt(_)
         | Command::Scan(_)
@@ -248,6 +257,7 @@ fn main() -> ExitCode {
     match cli.command {
         Command::Decode(args) => decode::run(args),
         Command::Monitor(args) => monitor::run(args),
+        Command::Sim(args) => sim::run(args),
         Command::Sdo(cmd) => live::run_sdo(cmd),
         Command::Nmt(args) => live::run_nmt(args),
         Command::Scan(args) => live::run_scan(args),

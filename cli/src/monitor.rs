@@ -80,6 +80,19 @@ pub struct MonitorArgs {
     pub duration: Option<Duration>,
 }
 
+/// A flag Ctrl-C (SIGINT; SIGTERM and SIGHUP too) sets, for the commands
+/// that run until --duration ends or Ctrl-C (`monitor`, `sim`); when no
+/// handler can be set, a warning on `err` says that `what` will not stop
+/// cleanly.
+pub fn stop_on_ctrl_c(what: &str, err: &mut dyn Write) -> Arc<AtomicBool> {
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
+        let _ = writeln!(err, "warning: Ctrl-C will not stop {what} cleanly: {e}");
+    }
+    stop
+}
+
 /// Seconds (`2`, `0.5`) or a time with a unit (`500ms`, `2s`, `1m`).
 pub fn parse_seconds(text: &str) -> Result<Duration, String> {
     let t = text.trim();
@@ -357,14 +370,7 @@ pub fn run(args: MonitorArgs) -> ExitCode {
             return ExitCode::from(1);
         }
     };
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
-    if let Err(e) = ctrlc::set_handler(move || flag.store(true, Ordering::Relaxed)) {
-        let _ = writeln!(
-            err,
-            "warning: Ctrl-C will not stop the monitor cleanly: {e}"
-        );
-    }
+    let stop = stop_on_ctrl_c("the monitor", &mut err);
     let view = args.table.then(|| match io::stdout().is_terminal() {
         true => View::Terminal,
         false => View::Plain,

@@ -13,11 +13,10 @@
 
 mod vcan;
 
-use vcan::{Sim, fails, iface, ok, scratch};
+use vcan::{Sim, fails, iface, ok, python, scratch};
 
 use std::io::{BufRead, BufReader, Write};
-use std::path::PathBuf;
-use std::process::{Command, Stdio};
+use std::process::Stdio;
 
 use eds2rust_runtime::lss::{BitRate, Identity};
 use eds2rust_sim::DeviceConfig;
@@ -493,28 +492,13 @@ struct Peer {
 
 impl Peer {
     fn spawn(command: &Value) -> Peer {
-        let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/python/local_node.py");
-        assert!(script.exists(), "missing {}", script.display());
-        let python = std::env::var_os("VCAN_PYTHON")
-            .map(PathBuf::from)
-            .unwrap_or_else(|| {
-                PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/pyoracle/bin/python3")
-            });
-        assert!(
-            python.exists(),
-            "no python with python-canopen at {} (VCAN_PYTHON; the python oracle tests create \
-             the venv, tests/vm/run.sh shares it)",
-            python.display()
-        );
-        let mut child = Command::new(&python)
-            .arg(&script)
+        let mut child = python("local_node.py")
             .arg(command.to_string())
-            .env("PYTHONDONTWRITEBYTECODE", "1")
             .stdin(Stdio::piped())
             .stdout(Stdio::piped())
             .stderr(Stdio::inherit())
             .spawn()
-            .unwrap_or_else(|e| panic!("starting {}: {e}", python.display()));
+            .unwrap_or_else(|e| panic!("starting python for local_node.py: {e}"));
         let stdout = BufReader::new(child.stdout.take().unwrap());
         let mut peer = Peer { child, stdout };
         assert_eq!(peer.read(), json!({"ready": true}));

@@ -13,13 +13,9 @@
 
 mod vcan;
 
-use vcan::{Sim, cli, fails, iface, ok, scratch};
+use vcan::{Ended, Running, Sim, fails, iface, ok, scratch};
 
-use std::io::{BufRead, BufReader, Read};
 use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::sync::mpsc;
-use std::thread::JoinHandle;
 use std::time::Duration;
 
 use eds2rust_runtime::transport::Bus;
@@ -57,10 +53,10 @@ fn expect_frame(bus: &mut SocketCanBus, id: u16, first: u8, what: &str) {
 }
 
 #[test]
-fn an_interface_that_cannot_be_opened_is_named_with_the_os_error() {
+fn an_interface_that_cannot_be_opened_is_named_with_what_to_do_and_the_os_error() {
     let err = fails(1, &["monitor", "-i", "nosuchcan0", "--duration", "1"]);
     assert!(
-        err.starts_with("error: cannot open CAN interface \"nosuchcan0\": "),
+        err.starts_with("error: nosuchcan0: no such CAN interface; create one with `ip link add"),
         "{err}"
     );
     assert!(err.contains("(os error "), "{err}");
@@ -105,126 +101,8 @@ fn usage_errors_and_help() {
     }
 }
 
-/// A running `eds2rust monitor`, its stdout and stderr read in threads.
-struct Monitor {
-    child: Child,
-    line: String,
-    listening: mpsc::Receiver<()>,
-    stdout: Option<JoinHandle<String>>,
-    stderr: Option<JoinHandle<String>>,
-}
-
-/// What a monitor printed and how it ended.
-struct Ended {
-    code: Option<i32>,
-    stdout: String,
-    stderr: String,
-}
-
-impl Monitor {
-    /// Starts it; [`Monitor::listening`] waits until it listens.
-    fn spawn(args: &[&str]) -> Monitor {
-        let line = format!("eds2rust {}", args.join(" "));
-        let mut child = Command::new(cli())
-            .args(args)
-            .stdin(Stdio::null())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap_or_else(|e| panic!("starting {line}: {e}"));
-        let mut out = child.stdout.take().unwrap();
-        let stdout = std::thread::spawn(move || {
-            let mut text = String::new();
-            let _ = out.read_to_string(&mut text);
-            text
-        });
-        let (tx, rx) = mpsc::channel();
-        let err = BufReader::new(child.stderr.take().unwrap());
-        let stderr = std::thread::spawn(move || {
-            let mut text = String::new();
-            for l in err.lines().map_while(Result::ok) {
-                if l.starts_with("monitor: listening on ") {
-                    let _ = tx.send(());
-                }
-                text.push_str(&l);
-                text.push('\n');
-            }
-            text
-        });
-        Monitor {
-            child,
-            line,
-            listening: rx,
-            stdout: Some(stdout),
-            stderr: Some(stderr),
-        }
-    }
-
-    /// Waits until it listens (its stderr says so, once it has read the
-    /// node's file and opened the interface: seconds under emulation).
-    fn listening(&mut self) {
-        if self
-            .listening
-            .recv_timeout(Duration::from_secs(90))
-            .is_err()
-        {
-            let ended = self.wait();
-            panic!("{} did not start listening:\n{}", self.line, ended.stderr);
-        }
-    }
-
-    /// Still running: the traffic comes within its --duration.
-    fn assert_running(&mut self) {
-        let status = self.child.try_wait().unwrap();
-        assert!(
-            status.is_none(),
-            "{} ended ({status:?}) before the node's traffic: the VM is too slow for its \
-             --duration",
-            self.line
-        );
-    }
-
-    /// Ctrl-C.
-    fn interrupt(&self) {
-        let pid = self.child.id().to_string();
-        let status = Command::new("kill")
-            .args(["-INT", &pid])
-            .status()
-            .expect("running kill");
-        assert!(status.success(), "kill -INT {pid}: {status}");
-    }
-
-    fn wait(&mut self) -> Ended {
-        let status = self.child.wait().expect("waiting for eds2rust monitor");
-        let stdout = self
-            .stdout
-            .take()
-            .map(|t| t.join().unwrap())
-            .unwrap_or_default();
-        let stderr = self
-            .stderr
-            .take()
-            .map(|t| t.join().unwrap())
-            .unwrap_or_default();
-        eprintln!("$ {}", self.line);
-        eprint!("{stdout}{stderr}");
-        eprintln!("(exit status {:?})", status.code());
-        Ended {
-            code: status.code(),
-            stdout,
-            stderr,
-        }
-    }
-}
-
-impl Drop for Monitor {
-    fn drop(&mut self) {
-        if self.stdout.is_some() {
-            let _ = self.child.kill();
-            let _ = self.child.wait();
-        }
-    }
-}
+/// The stderr line `eds2rust monitor` prints once it listens.
+const LISTENING: &str = "monitor: listening on ";
 
 /// The line of a plain table whose first cell is `node`.
 fn row_of(table: &str, node: u8) -> &str {
@@ -357,18 +235,22 @@ fn monitor_streams_tables_and_plots_the_linak_actuator() {
     let with = |rest: &[&'static str]| [&base[..], rest].concat();
     // Started together, each reads the file first (slow in the VM): the
     // durations leave room for that and for the traffic after it.
-    let mut json = Monitor::spawn(&with(&["--duration", DURATION, "--format", "json"]));
-    let mut table = Monitor::spawn(&with(&["--duration", DURATION, "--table"]));
-    let mut plot = Monitor::spawn(
+    let mut json = Running::spawn(
+        &with(&["--duration", DURATION, "--format", "json"]),
+        LISTENING,
+    );
+    let mut table = Running::spawn(&with(&["--duration", DURATION, "--table"]), LISTENING);
+    let mut plot = Running::spawn(
         &[
             &base[..],
             &["--plot", "Feedback.Position", "32:Feedback.Current"],
             &["--plot-file", &svg_arg],
         ]
         .concat(),
+        LISTENING,
     );
     for m in [&mut json, &mut table, &mut plot] {
-        m.listening();
+        m.ready();
     }
 
     // The master's part, from a socket of this test: the heartbeat every

@@ -90,7 +90,10 @@ fn signed_fields_are_sign_extended_and_gaps_skipped() {
     assert_eq!(tpdo.statusword.to_raw(), 0x0637);
     // The built-in CiA 402 meaning: the runtime's statusword, the same bits.
     let state = eds2rust_runtime::cia402::Statusword::from(tpdo.statusword).state();
-    assert_eq!(state, Some(eds2rust_runtime::cia402::State::OperationEnabled));
+    assert_eq!(
+        state,
+        Some(eds2rust_runtime::cia402::State::OperationEnabled)
+    );
     assert!(tpdo.statusword.is_operation_enabled());
     assert_eq!(tpdo.position_actual_value, -2);
     assert_eq!(tpdo.encode(), [0x37, 0x06, 0x00, 0xFE, 0xFF, 0xFF, 0xFF]);

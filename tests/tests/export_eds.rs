@@ -248,7 +248,11 @@ fn round_trip(devices: &[(String, Device)]) -> RoundTrip {
     for (name, original) in devices {
         let expected = expected_after_export(original, &mut tally);
         let (mut back, diagnostics) = read_export(name, &to_eds(original));
-        for entry in back.objects.values_mut().flat_map(|o| o.entries.values_mut()) {
+        for entry in back
+            .objects
+            .values_mut()
+            .flat_map(|o| o.entries.values_mut())
+        {
             entry.semantics = Default::default();
         }
         tally

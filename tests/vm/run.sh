@@ -10,7 +10,7 @@
 #              2 infrastructure failure (apt, download, build, boot,
 #                timeout, missing result marker); reason on stderr.
 # Environment: VM_TIMEOUT (seconds, default 300), VM_VCAN_COUNT (vcan
-#              interfaces, default 9), VM_MEMORY (MiB, default 512).
+#              interfaces, default 10), VM_MEMORY (MiB, default 512).
 set -Eeuo pipefail
 
 infra() {
@@ -27,8 +27,8 @@ VM=$ROOT/target/vm
 TIMEOUT=${VM_TIMEOUT:-300}
 # CAN_IFACES in the VM (tests/vm/init.sh): vcan0..vcan<N-1>. Entries 0-4:
 # cli/tests/live_vcan.rs, 4-7: tests/tests/vcan_python.rs, 8:
-# cli/tests/monitor_vcan.rs.
-VCAN_COUNT=${VM_VCAN_COUNT:-9}
+# cli/tests/monitor_vcan.rs, 9: cli/tests/sim_vcan.rs.
+VCAN_COUNT=${VM_VCAN_COUNT:-10}
 MEMORY=${VM_MEMORY:-512}
 TRIPLE=x86_64-unknown-linux-gnu
 # The CAN modules the VM loads, in load order (vcan needs can-dev).
@@ -210,13 +210,14 @@ build_tests() {
         -p eds2rust-tests --test vcan_python \
         --message-format=json-render-diagnostics >"$pyjson") ||
         infra "cargo build of the static python-canopen test binary failed"
-    # The CLI's live-bus commands (cli/tests/live_vcan.rs) and `eds2rust
-    # monitor` (cli/tests/monitor_vcan.rs), and the eds2rust binary they
-    # run, against the seed-device simulators and a python-canopen LocalNode.
+    # The CLI's live-bus commands (cli/tests/live_vcan.rs), `eds2rust
+    # monitor` (cli/tests/monitor_vcan.rs) and `eds2rust sim`
+    # (cli/tests/sim_vcan.rs), and the eds2rust binary they run, against the
+    # seed-device simulators and python-canopen.
     local clijson=$VM/cargo-cli.json
     (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
         CARGO_PROFILE_DEV_DEBUG=false cargo build --target "$TRIPLE" --target-dir "$BUILD" \
-        -p eds2rust-cli --bin eds2rust --test live_vcan --test monitor_vcan \
+        -p eds2rust-cli --bin eds2rust --test live_vcan --test monitor_vcan --test sim_vcan \
         --message-format=json-render-diagnostics >"$clijson") ||
         infra "cargo build of the static CLI and its live-bus tests failed"
     local cli
@@ -260,7 +261,9 @@ build_tests() {
 # ----------------------------------------------------------- shares ---
 # Host folders the VM mounts read-only at the same paths (virtio-9p), so
 # that python-canopen runs there from the host's venv: the test scripts,
-# the venv, the python it was made from and the system libraries.
+# the venv, the python it was made from and the system libraries; and the
+# EDS corpus beside the checkout when it is there (cli/tests/sim_vcan.rs
+# simulates one of its drives; without it the test says NOT RUN).
 PYVENV=$ROOT/target/pyoracle
 SHARES=()
 shares() {
@@ -276,6 +279,11 @@ shares() {
         [[ -d $dir && $dir != *[[:space:]=,]* ]] || infra "cannot share $dir into the VM"
         SHARES+=("$dir")
     done
+    local corpus
+    corpus=$(dirname "$ROOT")/shared/eds-corpus/files
+    if [[ -d $corpus && $corpus != *[[:space:]=,]* ]]; then
+        SHARES+=("$corpus")
+    fi
 }
 
 # -------------------------------------------------------- initramfs ---

@@ -35,20 +35,11 @@ impl LiveBus {
         LiveBus { inner }
     }
 
-    /// Opens SocketCAN interface `iface`.
+    /// Opens SocketCAN interface `iface` ([`open_socketcan`]).
     pub fn open(iface: &str) -> Result<LiveBus, LiveError> {
-        #[cfg(target_os = "linux")]
-        {
-            let bus = eds2rust_runtime::transport::socketcan::SocketCanBus::open(iface)
-                .map_err(|e| LiveError::Failed(e.to_string()))?;
-            Ok(LiveBus::new(Box::new(bus)))
-        }
-        #[cfg(not(target_os = "linux"))]
-        {
-            Err(LiveError::Failed(format!(
-                "cannot open CAN interface {iface:?}: SocketCAN needs Linux"
-            )))
-        }
+        open_socketcan(iface)
+            .map(LiveBus::new)
+            .map_err(LiveError::Failed)
     }
 }
 
@@ -60,6 +51,66 @@ impl Bus for LiveBus {
     fn recv(&mut self, timeout: Duration) -> io::Result<Option<Frame>> {
         self.inner.recv(timeout)
     }
+}
+
+/// Opens SocketCAN interface `iface` for every command that uses a bus;
+/// the error names the interface, says why and what to do (no such
+/// interface, not a CAN one, down, no SocketCAN in the kernel).
+pub fn open_socketcan(iface: &str) -> Result<Box<dyn Bus + Send>, String> {
+    #[cfg(target_os = "linux")]
+    {
+        use eds2rust_runtime::transport::socketcan::SocketCanBus;
+        let sys = std::path::Path::new("/sys/class/net").join(iface);
+        let bus = SocketCanBus::open(iface).map_err(|e| open_failed(iface, &sys, &e))?;
+        // IFF_UP: a socket binds to a down interface, sending fails.
+        let flags = std::fs::read_to_string(sys.join("flags")).unwrap_or_default();
+        let flags = u32::from_str_radix(flags.trim().trim_start_matches("0x"), 16).unwrap_or(1);
+        if flags & 1 == 0 {
+            return Err(format!(
+                "{iface}: the interface is down; bring it up with `ip link set up {iface}` \
+                 (a CAN adapter also needs its bit rate: \
+                 `ip link set {iface} type can bitrate 250000`)"
+            ));
+        }
+        Ok(Box::new(bus))
+    }
+    #[cfg(not(target_os = "linux"))]
+    {
+        Err(format!(
+            "{iface}: cannot open a CAN interface: SocketCAN needs Linux"
+        ))
+    }
+}
+
+#[cfg(target_os = "linux")]
+fn open_failed(iface: &str, sys: &std::path::Path, e: &io::Error) -> String {
+    let no_socketcan = !std::path::Path::new("/proc/net/can").exists();
+    if !sys.exists() {
+        let kernel = if no_socketcan {
+            " (this kernel has no SocketCAN loaded: `modprobe can-raw vcan` first)"
+        } else {
+            ""
+        };
+        return format!(
+            "{iface}: no such CAN interface; create one with \
+             `ip link add dev {iface} type vcan && ip link set up {iface}`{kernel} ({e})"
+        );
+    }
+    // ARPHRD_CAN: CAN adapters and vcan.
+    let link_type = std::fs::read_to_string(sys.join("type")).unwrap_or_default();
+    if !link_type.trim().is_empty() && link_type.trim() != "280" {
+        return format!(
+            "{iface}: not a CAN interface (link type {}); `ip link show type vcan` and \
+             `ip -details link show` list the CAN ones ({e})",
+            link_type.trim()
+        );
+    }
+    if no_socketcan {
+        return format!(
+            "{iface}: this kernel has no SocketCAN; load it with `modprobe can-raw` ({e})"
+        );
+    }
+    format!("{iface}: cannot open the CAN interface: {e}")
 }
 
 /// A master on `bus` that sends nothing of its own (no boot-up, no

@@ -1,14 +1,18 @@
 //! What the vcan tests of the `eds2rust` binary share (`live_vcan.rs`,
-//! `monitor_vcan.rs`): the interfaces of `CAN_IFACES`, the binary, scratch
-//! directories, running the CLI, and a seed simulator on an interface.
+//! `monitor_vcan.rs`, `sim_vcan.rs`): the interfaces of `CAN_IFACES`, the
+//! binary, scratch directories, running the CLI (to its end, or in the
+//! background until Ctrl-C), and a seed simulator on an interface.
 
 #![allow(dead_code)]
 
+use std::io::{BufRead, BufReader, Read};
 use std::path::PathBuf;
-use std::process::{Command, Output};
+use std::process::{Child, Command, Output, Stdio};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc;
 use std::thread::JoinHandle;
+use std::time::Duration;
 
 use eds2rust_runtime::blocking;
 use eds2rust_runtime::transport::socketcan::SocketCanBus;
@@ -72,6 +76,142 @@ pub fn fails<S: AsRef<str>>(code: i32, args: &[S]) -> String {
     let out = run(args);
     assert_eq!(out.status.code(), Some(code), "the exit status of eds2rust");
     String::from_utf8(out.stderr).unwrap()
+}
+
+/// `python3 cli/tests/python/SCRIPT`, with the python that has
+/// python-canopen: `VCAN_PYTHON`, or the venv the python oracle tests
+/// create (tests/vm/run.sh shares it into the VM).
+pub fn python(script: &str) -> Command {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let script = dir.join("tests/python").join(script);
+    assert!(script.exists(), "missing {}", script.display());
+    let python = std::env::var_os("VCAN_PYTHON")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| dir.join("../target/pyoracle/bin/python3"));
+    assert!(
+        python.exists(),
+        "no python with python-canopen at {} (VCAN_PYTHON; the python oracle tests create \
+         the venv, tests/vm/run.sh shares it)",
+        python.display()
+    );
+    let mut command = Command::new(&python);
+    command.arg(&script).env("PYTHONDONTWRITEBYTECODE", "1");
+    command
+}
+
+/// A command of the CLI running in the background (`monitor`, `sim`), its
+/// stdout and stderr read in threads.
+pub struct Running {
+    child: Child,
+    line: String,
+    ready: mpsc::Receiver<()>,
+    stdout: Option<JoinHandle<String>>,
+    stderr: Option<JoinHandle<String>>,
+}
+
+/// What a background command printed and how it ended.
+pub struct Ended {
+    pub code: Option<i32>,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+impl Running {
+    /// Starts `eds2rust args`; [`Running::ready`] waits for its first
+    /// stderr line starting with `ready`.
+    pub fn spawn(args: &[&str], ready: &'static str) -> Running {
+        let line = format!("eds2rust {}", args.join(" "));
+        let mut child = Command::new(cli())
+            .args(args)
+            .stdin(Stdio::null())
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap_or_else(|e| panic!("starting {line}: {e}"));
+        let mut out = child.stdout.take().unwrap();
+        let stdout = std::thread::spawn(move || {
+            let mut text = String::new();
+            let _ = out.read_to_string(&mut text);
+            text
+        });
+        let (tx, rx) = mpsc::channel();
+        let err = BufReader::new(child.stderr.take().unwrap());
+        let stderr = std::thread::spawn(move || {
+            let mut text = String::new();
+            for l in err.lines().map_while(Result::ok) {
+                if l.starts_with(ready) {
+                    let _ = tx.send(());
+                }
+                text.push_str(&l);
+                text.push('\n');
+            }
+            text
+        });
+        Running {
+            child,
+            line,
+            ready: rx,
+            stdout: Some(stdout),
+            stderr: Some(stderr),
+        }
+    }
+
+    /// Waits for the ready line (printed once the command has read its
+    /// files and opened the interface: seconds under emulation).
+    pub fn ready(&mut self) {
+        if self.ready.recv_timeout(Duration::from_secs(90)).is_err() {
+            let ended = self.wait();
+            panic!(
+                "{} did not get ready ({:?}):\n{}{}",
+                self.line, ended.code, ended.stdout, ended.stderr
+            );
+        }
+    }
+
+    /// Still running (the traffic comes within its --duration).
+    pub fn assert_running(&mut self) {
+        let status = self.child.try_wait().unwrap();
+        assert!(
+            status.is_none(),
+            "{} ended ({status:?}) before the node's traffic: the VM is too slow for its \
+             --duration",
+            self.line
+        );
+    }
+
+    /// Ctrl-C (SIGINT).
+    pub fn interrupt(&self) {
+        let pid = self.child.id().to_string();
+        let status = Command::new("kill")
+            .args(["-INT", &pid])
+            .status()
+            .expect("running kill");
+        assert!(status.success(), "kill -INT {pid}: {status}");
+    }
+
+    /// Waits for the end; prints the command line and its output.
+    pub fn wait(&mut self) -> Ended {
+        let status = self.child.wait().expect("waiting for eds2rust");
+        let join = |t: Option<JoinHandle<String>>| t.map(|t| t.join().unwrap()).unwrap_or_default();
+        let (stdout, stderr) = (join(self.stdout.take()), join(self.stderr.take()));
+        eprintln!("$ {}", self.line);
+        eprint!("{stdout}{stderr}");
+        eprintln!("(exit status {:?})", status.code());
+        Ended {
+            code: status.code(),
+            stdout,
+            stderr,
+        }
+    }
+}
+
+impl Drop for Running {
+    fn drop(&mut self) {
+        if self.stdout.is_some() {
+            let _ = self.child.kill();
+            let _ = self.child.wait();
+        }
+    }
 }
 
 /// A simulated device on a SocketCAN interface, in a thread.

@@ -149,7 +149,11 @@ impl StdMeaning {
 
     /// The runtime type `path` (a tuple struct over `raw`) is the entry's
     /// value type while the entry keeps the standard's meaning.
-    pub(crate) const fn runtime_value(mut self, path: &'static str, raw: &'static str) -> StdMeaning {
+    pub(crate) const fn runtime_value(
+        mut self,
+        path: &'static str,
+        raw: &'static str,
+    ) -> StdMeaning {
         self.runtime = Some(RuntimeType {
             path,
             newtype: true,

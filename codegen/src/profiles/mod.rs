@@ -119,7 +119,9 @@ impl Profile {
         let word = |index: u16| {
             device.objects.get(&index).is_some_and(|o| {
                 o.kind == ObjectKind::Var
-                    && o.entries.get(&0).is_some_and(|e| e.data_type == DataType::Unsigned16)
+                    && o.entries
+                        .get(&0)
+                        .is_some_and(|e| e.data_type == DataType::Unsigned16)
             })
         };
         (word(0x6040) && word(0x6041)).then_some(Profile::Cia402)
@@ -322,4 +324,3 @@ mod tests {
         }
     }
 }
-

@@ -144,8 +144,7 @@ impl Operation {
             need!(read, 0x6041, "Statusword"),
         ];
         const PROFILE_POSITION: &[Requirement] = &[MODES, TARGET_POSITION];
-        const PROFILE_VELOCITY: &[Requirement] =
-            &[MODES, need!(write, 0x60FF, "Target velocity")];
+        const PROFILE_VELOCITY: &[Requirement] = &[MODES, need!(write, 0x60FF, "Target velocity")];
         const HOMING: &[Requirement] = &[MODES, need!(write, 0x6098, "Homing method")];
         const MOTION_PROFILE: &[Requirement] = &[
             need!(write, 0x6081, "Profile velocity"),

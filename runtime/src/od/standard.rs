@@ -188,15 +188,27 @@ mod tests {
         assert_eq!(cob.can_id(), 0x185);
         assert_eq!(cob.with_not_valid(false).to_raw(), 0x185);
         assert_eq!(cob.with_can_id(0x1ABC_DEF0).can_id(), 0x1ABC_DEF0);
-        assert_eq!(<PdoCobId as Scalar>::from_raw(0x4000_0000).to_raw(), 0x4000_0000);
+        assert_eq!(
+            <PdoCobId as Scalar>::from_raw(0x4000_0000).to_raw(),
+            0x4000_0000
+        );
     }
 
     #[test]
     fn transmission_types_and_timers() {
-        assert_eq!(TransmissionType(0).kind(), TransmissionKind::SynchronousAcyclic);
+        assert_eq!(
+            TransmissionType(0).kind(),
+            TransmissionKind::SynchronousAcyclic
+        );
         assert_eq!(TransmissionType(3).kind(), TransmissionKind::Synchronous(3));
-        assert_eq!(TransmissionType(245).kind(), TransmissionKind::Reserved(245));
-        assert_eq!(TransmissionType::EVENT_DRIVEN.kind(), TransmissionKind::EventDrivenProfile);
+        assert_eq!(
+            TransmissionType(245).kind(),
+            TransmissionKind::Reserved(245)
+        );
+        assert_eq!(
+            TransmissionType::EVENT_DRIVEN.kind(),
+            TransmissionKind::EventDrivenProfile
+        );
         assert!(TransmissionType(252).is_synchronous() && !TransmissionType(254).is_synchronous());
         assert_eq!(InhibitTime(15).duration(), Duration::from_micros(1500));
         assert_eq!(EventTimer(0).duration(), None);

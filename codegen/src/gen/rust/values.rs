@@ -194,10 +194,7 @@ pub(crate) fn runtime_plan(
 ) -> Option<Plan> {
     let ty = canonical.runtime_value(index, entry)?;
     let raw = Prim::of(entry.data_type)?;
-    (raw.tokens().to_string() == ty.raw).then_some(Plan::Runtime {
-        path: ty.path,
-        raw,
-    })
+    (raw.tokens().to_string() == ty.raw).then_some(Plan::Runtime { path: ty.path, raw })
 }
 
 /// Everything the value-type emitters need of their surroundings.
