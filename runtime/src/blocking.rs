@@ -26,7 +26,7 @@ use crate::{Instant, Service};
 
 mod error;
 pub(crate) mod master;
-mod stream;
+pub(crate) mod stream;
 pub use master::{
     Cia402Error, DRIVE_EVENTS_KEPT, DriveHandle, LssRequestError, MASTER_QUEUE_CAPACITY, Master,
 };

@@ -9,6 +9,7 @@ use std::sync::{Arc, Mutex};
 use std::thread;
 use std::time::Duration;
 
+use eds2rust_runtime::Frame;
 use eds2rust_runtime::blocking::{self, Cia402Error, Master};
 use eds2rust_runtime::cia402::requirements::{Operation, Problem};
 use eds2rust_runtime::cia402::session::StatuswordPdo;
@@ -21,71 +22,17 @@ use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::server::{SdoServer, ServerConfig};
 use eds2rust_runtime::transport::Clock;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
-use eds2rust_runtime::{Frame, Instant};
 
 #[path = "cia402_master/sim.rs"]
 mod sim;
 
 const NODE: u8 = 0x20;
 
-const fn rw(index: u16, name: &'static str, data_type: DataType) -> ObjectInfo {
-    ObjectInfo::new(index, 0, name, data_type, AccessRight::Rw, true)
-}
-
-use sim::{DeviceNode, DriveStore, SETTLE, Sim};
+use sim::{DeviceNode, DriveStore, FULL, NO_VELOCITY, SETTLE, Sim, fast_config, rw, states};
 
 fn node() -> NodeId {
     NodeId::new(NODE).unwrap()
 }
-
-/// The full table of the simulated drive.
-static FULL: [ObjectInfo; 8] = [
-    ObjectInfo::new(
-        0x603F,
-        0,
-        "Error code",
-        DataType::Unsigned16,
-        AccessRight::Ro,
-        true,
-    ),
-    rw(0x6040, "Controlword", DataType::Unsigned16),
-    ObjectInfo::new(
-        0x6041,
-        0,
-        "Statusword",
-        DataType::Unsigned16,
-        AccessRight::Ro,
-        true,
-    ),
-    rw(0x6060, "Modes of operation", DataType::Integer8),
-    rw(0x607A, "Target position", DataType::Integer32),
-    rw(0x6098, "Homing method", DataType::Integer8),
-    rw(0x60FF, "Target velocity", DataType::Integer32),
-    ObjectInfo::new(
-        0x6061,
-        0,
-        "Modes of operation display",
-        DataType::Integer8,
-        AccessRight::Ro,
-        true,
-    ),
-];
-
-/// A table without 0x60FF (a drive without profile velocity).
-static NO_VELOCITY: [ObjectInfo; 5] = [
-    rw(0x6040, "Controlword", DataType::Unsigned16),
-    ObjectInfo::new(
-        0x6041,
-        0,
-        "Statusword",
-        DataType::Unsigned16,
-        AccessRight::Ro,
-        true,
-    ),
-    rw(0x6060, "Modes of operation", DataType::Integer8),
-    rw(0x607A, "Target position", DataType::Integer32),
-    rw(0x6098, "Homing method", DataType::Integer8),
-];
 
 struct Rig {
     master: Master<VirtualPort>,
@@ -147,25 +94,6 @@ impl Drop for Rig {
             let _ = t.join();
         }
     }
-}
-
-fn states(events: &[(Instant, Event)]) -> Vec<State> {
-    events
-        .iter()
-        .filter_map(|(_, e)| match e {
-            Event::StateChanged { to: Some(to), .. } => Some(*to),
-            _ => None,
-        })
-        .collect()
-}
-
-fn fast_config() -> SessionConfig {
-    let mut config = SessionConfig::default();
-    config.drive = config
-        .drive
-        .with_timeout(Step::FaultReset, Duration::from_millis(60))
-        .with_timeout(Step::TargetReached, Duration::from_secs(3));
-    config
 }
 
 #[test]

@@ -78,16 +78,6 @@ async fn transfers_of_several_tasks_take_turns() {
     }
 }
 
-/// The next frame `port` receives with `cob_id`.
-async fn recv_from(port: &mut VirtualPort, cob_id: u16) -> std::io::Result<Frame> {
-    loop {
-        let frame = AsyncBus::recv(port).await?;
-        if frame.cob_id() == Some(cob_id) {
-            return Ok(frame);
-        }
-    }
-}
-
 #[tokio::test(start_paused = true)]
 async fn a_cancelled_transfer_is_aborted_and_the_next_succeeds() {
     let rig = Rig::new(|_| {}).await;

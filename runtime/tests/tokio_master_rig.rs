@@ -20,6 +20,7 @@ use eds2rust_runtime::pdo::{PdoTransmitter, TransmitterConfig};
 use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
 use eds2rust_runtime::tokio::{self as driver, Deadline, Events, Master};
+use eds2rust_runtime::transport::AsyncBus;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use eds2rust_runtime::{CanId, Frame, Instant, Service};
 use tokio::task::JoinHandle;
@@ -231,5 +232,15 @@ impl Rig {
         })
         .await
         .expect("no such event within 10 s")
+    }
+}
+
+/// The next frame `port` receives with `cob_id`.
+pub async fn recv_from(port: &mut VirtualPort, cob_id: u16) -> std::io::Result<Frame> {
+    loop {
+        let frame = AsyncBus::recv(port).await?;
+        if frame.cob_id() == Some(cob_id) {
+            return Ok(frame);
+        }
     }
 }

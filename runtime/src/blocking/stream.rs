@@ -2,7 +2,8 @@
 //! [`io::Read`] (a file, a slice) and an upload written to an
 //! [`io::Write`], neither held whole in memory, with a progress callback.
 //! The core keeps a window ([`client::WINDOW`] bytes); see
-//! [`client::SdoClient::download_stream`].
+//! [`client::SdoClient::download_stream`]. The tokio master's streamed
+//! transfers run the same [`Pump`] and end the same way.
 
 use core::ops::ControlFlow;
 use core::time::Duration;
@@ -22,14 +23,14 @@ use crate::{Instant, Service};
 const CHUNK: usize = 1024;
 
 /// What the hook of a streamed transfer found wrong with its source or sink.
-enum Stop {
+pub(crate) enum Stop {
     Source(io::Error),
     Sink(io::Error),
 }
 
 /// The data side of a streamed transfer: feeds the core from `reader`,
 /// hands what the core received to `writer`, and reports progress.
-struct Pump<'a, R, W, P> {
+pub(crate) struct Pump<'a, R, W, P> {
     reader: Option<&'a mut R>,
     writer: Option<&'a mut W>,
     size: Option<usize>,
@@ -42,7 +43,7 @@ struct Pump<'a, R, W, P> {
 }
 
 impl<'a, R: Read, W: Write, P: FnMut(Progress)> Pump<'a, R, W, P> {
-    fn new(
+    pub(crate) fn new(
         reader: Option<&'a mut R>,
         writer: Option<&'a mut W>,
         size: Option<usize>,
@@ -63,7 +64,7 @@ impl<'a, R: Read, W: Write, P: FnMut(Progress)> Pump<'a, R, W, P> {
 
     /// One round: returns `Break` (with `self.stop` set) when the source or
     /// the sink failed.
-    fn round(&mut self, core: &mut client::SdoClient, now: Instant) -> ControlFlow<()> {
+    pub(crate) fn round(&mut self, core: &mut client::SdoClient, now: Instant) -> ControlFlow<()> {
         if let Err(stop) = self.feed(core, now).and_then(|()| self.take(core)) {
             self.stop = Some(stop);
             return ControlFlow::Break(());
@@ -142,7 +143,7 @@ fn read_some(reader: &mut impl Read, buf: &mut [u8]) -> io::Result<usize> {
 }
 
 /// The bound of a streamed transfer of `len` bytes (unknown: none).
-fn bound(len: Option<usize>, config: &ClientConfig) -> Option<Duration> {
+pub(crate) fn bound(len: Option<usize>, config: &ClientConfig) -> Option<Duration> {
     let steps = len?.div_ceil(7).saturating_add(4);
     Some(
         config
@@ -151,32 +152,34 @@ fn bound(len: Option<usize>, config: &ClientConfig) -> Option<Duration> {
     )
 }
 
-/// Starts a streamed download on `core`; returns the announced length.
-fn start_download(
+/// The length a streamed download of `size` bytes announces (at most
+/// u32::MAX: CiA 301's 32-bit size).
+pub(crate) fn announced(size: Option<u64>) -> Result<Option<u32>, Error> {
+    match size.map(u32::try_from) {
+        None => Ok(None),
+        Some(Ok(size)) => Ok(Some(size)),
+        Some(Err(_)) => Err(Error::Source(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            "an SDO download announces at most u32::MAX bytes",
+        ))),
+    }
+}
+
+/// Starts a streamed download announcing `announced` bytes on `core`.
+pub(crate) fn start_download(
     core: &mut client::SdoClient,
     now: Instant,
     (index, sub): (u16, u8),
-    size: Option<u64>,
+    announced: Option<u32>,
     method: Method,
-) -> Result<Option<usize>, Error> {
-    let announced = match size.map(u32::try_from) {
-        None => None,
-        Some(Ok(size)) => Some(size),
-        Some(Err(_)) => {
-            return Err(Error::Source(io::Error::new(
-                io::ErrorKind::InvalidInput,
-                "an SDO download announces at most u32::MAX bytes",
-            )));
-        }
-    };
+) -> Result<(), Error> {
     while core.poll_event().is_some() {}
     core.download_stream(now, index, sub, announced, method)
-        .map_err(|client::Busy| Error::Busy)?;
-    Ok(announced.map(|s| s as usize))
+        .map_err(|client::Busy| Error::Busy)
 }
 
 /// Starts a streamed upload on `core`.
-fn start_upload(
+pub(crate) fn start_upload(
     core: &mut client::SdoClient,
     now: Instant,
     (index, sub): (u16, u8),
@@ -191,7 +194,7 @@ fn start_upload(
 /// the source's or sink's when the pump stopped it (the transfer is then
 /// aborted with 0x08000000), else what the loop says. The abort frame is
 /// left in `core` for the caller to send.
-fn stream_error<R, W, P>(
+pub(crate) fn stream_error<R, W, P>(
     core: &mut client::SdoClient,
     pump: &mut Pump<'_, R, W, P>,
     error: DriveError,
@@ -209,9 +212,22 @@ fn stream_error<R, W, P>(
     }
 }
 
+/// Reports the end of a download (all that was fed) when the last
+/// progress seen fell short of it.
+pub(crate) fn finish_download<R, W, P: FnMut(Progress)>(pump: &mut Pump<'_, R, W, P>) {
+    if let Some(p) = pump.last
+        && p.done != pump.fed
+    {
+        (pump.progress)(Progress {
+            done: pump.fed,
+            total: p.total,
+        });
+    }
+}
+
 /// Writes the rest an upload's end event carried, flushes, and reports the
 /// end; returns the bytes written in all.
-fn finish_upload<R, W: Write, P: FnMut(Progress)>(
+pub(crate) fn finish_upload<R, W: Write, P: FnMut(Progress)>(
     pump: &mut Pump<'_, R, W, P>,
     rest: &[u8],
 ) -> Result<usize, Error> {
@@ -253,10 +269,14 @@ impl<B: Bus> SdoClient<B> {
         progress: impl FnMut(Progress),
     ) -> Result<(), Error> {
         let now = self.clock.now();
-        let len = start_download(&mut self.core, now, (index, sub), size, method)?;
+        let announced = announced(size)?;
+        start_download(&mut self.core, now, (index, sub), announced, method)?;
+        let len = announced.map(|s| s as usize);
         let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
         let total = bound(len, self.core.config());
-        self.run_stream(index, sub, &mut pump, now, total).map(drop)
+        self.run_stream(index, sub, &mut pump, now, total)?;
+        finish_download(&mut pump);
+        Ok(())
     }
 
     /// Reads (index, sub) into `writer` as the data arrives, holding only
@@ -368,12 +388,15 @@ impl<B: Bus> Master<B> {
         progress: impl FnMut(Progress),
     ) -> Result<(), Error> {
         let now = self.now();
+        let announced = announced(size)?;
         let client = self.core_mut().sdo_or_default(node);
-        let len = start_download(client, now, (index, sub), size, method)?;
+        start_download(client, now, (index, sub), announced, method)?;
+        let len = announced.map(|s| s as usize);
         let total = bound(len, client.config());
         let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
-        self.run_stream(node, (index, sub), &mut pump, now, total)
-            .map(drop)
+        self.run_stream(node, (index, sub), &mut pump, now, total)?;
+        finish_download(&mut pump);
+        Ok(())
     }
 
     /// [`SdoClient::upload_into`] from `node` while the master keeps

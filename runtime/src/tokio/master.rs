@@ -17,6 +17,7 @@ mod driver;
 mod lss;
 mod sdo;
 mod stream;
+mod streamed;
 
 pub use crate::blocking::{LssRequestError, MASTER_QUEUE_CAPACITY};
 pub use drive::DriveHandle;
@@ -127,6 +128,9 @@ struct Shared {
     /// Signalled after every round of frames the driver sent (and when it
     /// stops).
     flushed: Notify,
+    /// Signalled after every frame the driver received: a streamed
+    /// transfer feeds its source or drains its sink then.
+    received: Notify,
     /// LSS requests take turns.
     lss_turn: Arc<::tokio::sync::Mutex<()>>,
     clock: Clock,
@@ -312,6 +316,7 @@ impl Master {
             }),
             wake: Notify::new(),
             flushed: Notify::new(),
+            received: Notify::new(),
             lss_turn: Arc::new(::tokio::sync::Mutex::new(())),
             clock,
         });

@@ -5,8 +5,10 @@ use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
 use eds2rust_runtime::cia402::{
-    Controlword, DeviceConfig, DeviceEvent, DeviceStateMachine, ModeOfOperation, State,
+    Controlword, DeviceConfig, DeviceEvent, DeviceStateMachine, Event, ModeOfOperation,
+    SessionConfig, State, Step,
 };
+use eds2rust_runtime::od::{AccessRight, DataType, ObjectInfo};
 use eds2rust_runtime::sdo::AbortCode;
 use eds2rust_runtime::sdo::server::{ObjectStore, SdoServer};
 use eds2rust_runtime::transport::Clock;
@@ -19,9 +21,64 @@ pub const SPEED: u64 = 2;
 /// Time a velocity change or homing takes.
 pub const SETTLE: Duration = Duration::from_millis(40);
 
+pub const fn rw(index: u16, name: &'static str, data_type: DataType) -> ObjectInfo {
+    ObjectInfo::new(index, 0, name, data_type, AccessRight::Rw, true)
+}
+
+/// The full table of the simulated drive.
+pub static FULL: [ObjectInfo; 8] = [
+    ObjectInfo::new(
+        0x603F,
+        0,
+        "Error code",
+        DataType::Unsigned16,
+        AccessRight::Ro,
+        true,
+    ),
+    rw(0x6040, "Controlword", DataType::Unsigned16),
+    ObjectInfo::new(
+        0x6041,
+        0,
+        "Statusword",
+        DataType::Unsigned16,
+        AccessRight::Ro,
+        true,
+    ),
+    rw(0x6060, "Modes of operation", DataType::Integer8),
+    rw(0x607A, "Target position", DataType::Integer32),
+    rw(0x6098, "Homing method", DataType::Integer8),
+    rw(0x60FF, "Target velocity", DataType::Integer32),
+    ObjectInfo::new(
+        0x6061,
+        0,
+        "Modes of operation display",
+        DataType::Integer8,
+        AccessRight::Ro,
+        true,
+    ),
+];
+
+/// A table without 0x60FF (a drive without profile velocity).
+pub static NO_VELOCITY: [ObjectInfo; 5] = [
+    rw(0x6040, "Controlword", DataType::Unsigned16),
+    ObjectInfo::new(
+        0x6041,
+        0,
+        "Statusword",
+        DataType::Unsigned16,
+        AccessRight::Ro,
+        true,
+    ),
+    rw(0x6060, "Modes of operation", DataType::Integer8),
+    rw(0x607A, "Target position", DataType::Integer32),
+    rw(0x6098, "Homing method", DataType::Integer8),
+];
+
 /// The simulated drive.
 pub struct Sim {
     pub clock: Clock,
+    /// How `clock` is read: `Clock::now` (std), or tokio's paused clock.
+    pub now: fn(&Clock) -> Instant,
     pub last: Instant,
     pub device: DeviceStateMachine,
     pub position: i64,
@@ -41,11 +98,17 @@ pub struct Sim {
 
 impl Sim {
     pub fn new(clock: Clock, config: DeviceConfig) -> Sim {
-        let now = clock.now();
+        Sim::with_now(clock, Clock::now, config)
+    }
+
+    /// The drive reading `clock` with `now`.
+    pub fn with_now(clock: Clock, now: fn(&Clock) -> Instant, config: DeviceConfig) -> Sim {
+        let at = now(&clock);
         Sim {
             clock,
-            last: now,
-            device: DeviceStateMachine::new(now, config),
+            now,
+            last: at,
+            device: DeviceStateMachine::new(at, config),
             position: 0,
             goal: 0,
             target_position: 0,
@@ -60,9 +123,14 @@ impl Sim {
         }
     }
 
+    /// The drive's time.
+    pub fn now(&self) -> Instant {
+        (self.now)(&self.clock)
+    }
+
     /// Runs the device and the motion model to now.
     pub fn update(&mut self) {
-        let now = self.clock.now();
+        let now = self.now();
         if self.device.poll_timeout().is_some_and(|at| at <= now) {
             self.device.handle_timeout(now);
         }
@@ -148,7 +216,7 @@ impl ObjectStore for DriveStore {
     fn write(&mut self, index: u16, _: u8, data: &[u8]) -> Result<(), AbortCode> {
         let mut sim = self.0.lock().unwrap();
         sim.update();
-        let now = sim.clock.now();
+        let now = sim.now();
         match index {
             0x6040 => {
                 let cw = u16::from_le_bytes(value(data)?);
@@ -213,4 +281,25 @@ impl Service for DeviceNode {
     fn poll_timeout(&self) -> Option<Instant> {
         eds2rust_runtime::time::earliest(self.sdo.poll_timeout(), self.tpdo.map(|(_, at)| at))
     }
+}
+
+/// The states the drive's events went through.
+pub fn states(events: &[(Instant, Event)]) -> Vec<State> {
+    events
+        .iter()
+        .filter_map(|(_, e)| match e {
+            Event::StateChanged { to: Some(to), .. } => Some(*to),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The helper's defaults with short fault-reset and target timeouts.
+pub fn fast_config() -> SessionConfig {
+    let mut config = SessionConfig::default();
+    config.drive = config
+        .drive
+        .with_timeout(Step::FaultReset, Duration::from_millis(60))
+        .with_timeout(Step::TargetReached, Duration::from_secs(3));
+    config
 }

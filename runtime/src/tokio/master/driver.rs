@@ -97,6 +97,8 @@ impl<B: AsyncBus> Driver<B> {
                     let mut state = self.shared.lock();
                     let now = self.shared.now();
                     state.core.handle_frame(now, &frame);
+                    drop(state);
+                    self.shared.received.notify_waiters();
                 }
                 () = sleep => {}
             }

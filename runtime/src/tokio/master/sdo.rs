@@ -1,16 +1,18 @@
 //! The SDO calls of the tokio [`Master`]: raw and typed transfers, and the
 //! PDO configuration over them.
 
+use core::time::Duration;
 use std::vec::Vec;
 
 use ::tokio::sync::oneshot;
 
 use super::{Error, Master, SdoWaiter, Shared};
+use crate::Instant;
 use crate::blocking::{DriveError, Transfer, Upload, encode, give_up, visible_string};
 use crate::od::{self, Entry, NodeId};
 use crate::pdo::PdoConfig;
 use crate::pdo::blocking::{PdoConfigError, SdoAccess, run_steps};
-use crate::sdo::client::Method;
+use crate::sdo::client::{self, Method};
 use crate::sdo::typed;
 
 /// Ends the transfer of a call that did not see its end (dropped, or past
@@ -28,6 +30,9 @@ fn abandon(shared: &Shared, node: NodeId, id: u64, why: DriveError) -> Option<Er
     shared.wake.notify_one();
     Some(error)
 }
+
+/// The round of a transfer that is not streamed (never called).
+type NoRound = fn(&mut client::SdoClient, Instant) -> Result<(), Error>;
 
 /// Abandons the transfer when the call's future is dropped before its end.
 struct Guard<'a> {
@@ -53,6 +58,32 @@ impl Master {
         sub: u8,
         transfer: Transfer<'_>,
     ) -> Result<Upload, Error> {
+        let start = |client: &mut client::SdoClient, now| {
+            transfer.start(client, now, index, sub)?;
+            Ok(Some(transfer.bound(client.config())))
+        };
+        self.run_transfer(node, index, sub, start, None::<NoRound>)
+            .await
+    }
+
+    /// Runs one transfer with `node` to its end: waits for the node's turn,
+    /// `start`s it on the core (which gives the bound of the whole
+    /// transfer, `None`: unbounded), and waits for its end event, giving up
+    /// (aborting) past the bound or when dropped. A streamed transfer runs
+    /// `round` on the node's client once at the start and after every
+    /// frame the driver receives; an error of `round` ends the transfer
+    /// with it (`round` has queued the abort).
+    pub(super) async fn run_transfer<R>(
+        &self,
+        node: NodeId,
+        index: u16,
+        sub: u8,
+        start: impl FnOnce(&mut client::SdoClient, Instant) -> Result<Option<Duration>, Error>,
+        mut round: Option<R>,
+    ) -> Result<Upload, Error>
+    where
+        R: FnMut(&mut client::SdoClient, Instant) -> Result<(), Error>,
+    {
         let turn = {
             let mut state = self.shared.lock();
             state.running()?;
@@ -64,8 +95,7 @@ impl Master {
             state.running()?;
             let now = self.shared.now();
             let client = state.core.sdo_or_default(node);
-            transfer.start(client, now, index, sub)?;
-            let deadline = now + transfer.bound(client.config());
+            let bound = start(client, now)?;
             let (tx, rx) = oneshot::channel();
             let id = state.next_id();
             let waiter = SdoWaiter {
@@ -75,19 +105,48 @@ impl Master {
                 reply: tx,
             };
             state.sdo.insert(node, waiter);
-            (rx, deadline, id)
+            (rx, bound.map(|b| now + b), id)
         };
-        self.shared.wake.notify_one();
         let mut guard = Guard {
             shared: &self.shared,
             node,
             id,
             armed: true,
         };
-        let wake = ::tokio::time::Instant::from_std(self.shared.clock.to_std(deadline));
-        let result = ::tokio::select! {
-            result = &mut reply => Some(result),
-            () = ::tokio::time::sleep_until(wake) => None,
+        let wake =
+            deadline.map(|at| ::tokio::time::Instant::from_std(self.shared.clock.to_std(at)));
+        let result = loop {
+            // Armed before the round looks at the core, so that a frame
+            // received after it wakes this call.
+            let received = self.shared.received.notified();
+            let mut received = core::pin::pin!(received);
+            if let Some(round) = round.as_mut() {
+                received.as_mut().enable();
+                let mut state = self.shared.lock();
+                if state.sdo.get(&node).is_some_and(|w| w.id == id) {
+                    let now = self.shared.now();
+                    if let Err(error) = round(state.core.sdo_or_default(node), now) {
+                        state.sdo.remove(&node);
+                        drop(state);
+                        guard.armed = false;
+                        self.shared.wake.notify_one();
+                        return Err(error);
+                    }
+                }
+            }
+            self.shared.wake.notify_one();
+            let until = async {
+                match wake {
+                    Some(wake) => ::tokio::time::sleep_until(wake).await,
+                    None => core::future::pending().await,
+                }
+            };
+            let streamed = round.is_some();
+            ::tokio::select! {
+                result = &mut reply => break Some(result),
+                () = until => break None,
+                () = received, if streamed => {}
+            }
         };
         guard.armed = false;
         let result = match result {
