@@ -1,8 +1,9 @@
 //! `tokio::Master::drive` under tokio's paused clock, against the simulated
 //! CiA 402 drive of `cia402_master.rs` (node 0x20, its time read from the
 //! paused clock) served on a task: the same requests as the blocking
-//! master, a dropped request cancelled with the next one running, and a
-//! missing object refused before any frame.
+//! master (cyclic synchronous position at its period), a dropped request
+//! cancelled with the next one running, and a missing object refused
+//! before any frame.
 #![cfg(feature = "tokio")]
 
 use std::sync::{Arc, Mutex};
@@ -200,5 +201,35 @@ async fn a_missing_object_is_refused_before_any_frame() {
     tokio::time::sleep(Duration::from_millis(10)).await;
     assert_eq!(rig.frames(), 0, "frames were sent for a refused request");
     drop(drive);
+    rig.stop().await;
+}
+
+#[tokio::test(start_paused = true)]
+async fn homing_then_cyclic_synchronous_position_every_period() {
+    let rig = Rig::new();
+    rig.sim.lock().unwrap().position = 77;
+    let mut drive = rig.master.drive(node(), &FULL, config()).unwrap();
+    drive.enable().await.unwrap();
+    drive.home(Some(35)).await.unwrap();
+    let started = tokio::time::Instant::now();
+    drive
+        .run_csp(Duration::from_millis(10), [10, 20, 30])
+        .await
+        .unwrap();
+    // Three periods of the paused clock.
+    assert_eq!(started.elapsed(), Duration::from_millis(30));
+    let kinds: Vec<Event> = drive.take_events().into_iter().map(|(_, e)| e).collect();
+    assert!(kinds.contains(&Event::HomingAttained));
+    drop(drive);
+    {
+        let sim = rig.sim.lock().unwrap();
+        assert_eq!(sim.homing_method, 35);
+        assert_eq!(sim.position, 0);
+        assert_eq!(sim.csp_targets, [10, 20, 30]);
+        assert_eq!(
+            sim.device.mode(),
+            ModeOfOperation::CyclicSynchronousPosition
+        );
+    }
     rig.stop().await;
 }

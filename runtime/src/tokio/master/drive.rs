@@ -279,6 +279,25 @@ impl DriveHandle {
         self.request(Request::CspTarget(target)).await
     }
 
+    /// Cyclic synchronous position: one target of `targets` every
+    /// `period` ([`DriveHandle::csp_target`], then a sleep until the period
+    /// is over; the driver keeps the cores, SYNC included, running). Stops
+    /// at the first error (the drive left Operation enabled, a following
+    /// error).
+    pub async fn run_csp(
+        &mut self,
+        period: core::time::Duration,
+        targets: impl IntoIterator<Item = i32>,
+    ) -> Result<(), Cia402Error> {
+        let mut next = ::tokio::time::Instant::now();
+        for target in targets {
+            next += period;
+            self.csp_target(target).await?;
+            ::tokio::time::sleep_until(next).await;
+        }
+        Ok(())
+    }
+
     /// A fresh statusword.
     pub async fn statusword(&mut self) -> Result<Statusword, Cia402Error> {
         self.request(Request::Statusword).await?;
