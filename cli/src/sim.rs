@@ -1,8 +1,10 @@
-//! `eds2rust sim FILE --iface IFACE [--node N]`: a simulated device from any
-//! EDS/DCF file or YAML object table on a SocketCAN interface
-//! (docs/sim-cli.md), for developing a master before the hardware arrives.
+//! `eds2rust sim FILE [--overlay YAML]... --iface IFACE [--node N]`: a
+//! simulated device from any EDS/DCF file or YAML object table on a
+//! SocketCAN interface (docs/sim-cli.md), for developing a master before
+//! the hardware arrives.
 //!
-//! The object table comes from `eds2rust_sim::file::load`, the device is
+//! The object table comes from `eds2rust_sim::file::load_with_overlays`
+//! (the file and its YAML overlays), the device is
 //! `eds2rust_sim::Device` (SDO server, NMT, heartbeat, PDOs per the
 //! table), with the generic CiA 402 drive (`eds2rust_sim::cia402`) when
 //! the file is a drive. It runs on the calling thread through the
@@ -50,6 +52,11 @@ const HEARTBEAT_TIME: u16 = 0x1017;
 pub struct SimArgs {
     /// The device: an EDS/DCF file or a YAML object table (.yaml, .yml).
     pub file: PathBuf,
+    /// A YAML overlay table (without `base:`) applied on FILE: names,
+    /// defaults, limits, added or deleted objects; may be given several
+    /// times, applied in order.
+    #[arg(long = "overlay", value_name = "YAML")]
+    pub overlays: Vec<PathBuf>,
     /// The SocketCAN interface the device is on (can0, vcan0).
     #[arg(long, short = 'i', value_name = "IFACE")]
     pub iface: String,
@@ -62,9 +69,21 @@ pub struct SimArgs {
     /// it, Ctrl-C stops (SIGINT; SIGTERM and SIGHUP too).
     #[arg(long, value_name = "SECONDS", value_parser = crate::monitor::parse_seconds)]
     pub duration: Option<Duration>,
+    /// A CiA 402 drive's mechanics this many times faster than real time
+    /// (moves, ramps, homing, the drive's time windows); 1 by default.
+    #[arg(long, value_name = "F", default_value_t = 1.0, value_parser = time_scale)]
+    pub time_scale: f64,
     /// Print only errors: no event lines, no status lines, no warnings.
     #[arg(long, short = 'q')]
     pub quiet: bool,
+}
+
+/// `--time-scale F`: a positive, finite factor.
+fn time_scale(text: &str) -> Result<f64, String> {
+    text.parse::<f64>()
+        .ok()
+        .filter(|f| f.is_finite() && *f > 0.0)
+        .ok_or_else(|| format!("`{text}` is not a positive factor (1, 10, 0.5)"))
 }
 
 /// A model event as one line (`None`: not worth one).
@@ -121,7 +140,7 @@ impl Describe for Cia402Event {
 /// Runs the command; the exit status (see the module documentation).
 pub fn run(args: SimArgs) -> ExitCode {
     let mut err = io::stderr();
-    let table = match file::load(&args.file) {
+    let table = match file::load_with_overlays(&args.file, &args.overlays) {
         Ok(table) => table,
         Err(e) => {
             for line in &e.errors {
@@ -178,8 +197,9 @@ pub fn simulate(
     err: &mut dyn Write,
 ) -> ExitCode {
     // Names and types of the entries for the event lines (the file read
-    // once more, into the IR; `file::load` keeps only the table).
-    let od = Od::load(&args.file).ok();
+    // once more, into the IR; `file::load_with_overlays` keeps only the
+    // table).
+    let od = Od::load_with_overlays(&args.file, &args.overlays).ok();
     let drive = table.cia402 && table.cia402_lacks().is_empty();
     let clock = Clock::new();
     let config = DeviceConfig::node(node);
@@ -195,7 +215,8 @@ pub fn simulate(
         err,
     };
     if drive {
-        let device = cia402::simulator(table.objects, config, Cia402::new(), clock.now());
+        let model = Cia402::new().with_time_scale(args.time_scale);
+        let device = cia402::simulator(table.objects, config, model, clock.now());
         session.run(device, "a CiA 402 drive")
     } else {
         let device = Device::new(table.objects, config, (), clock.now());
@@ -269,20 +290,18 @@ impl Session<'_> {
                 ControlFlow::Break,
                 until,
             ) {
-                Ok(event) => {
-                    if let Some(line) = self.describe(&device, event)
-                        && !self.args.quiet
-                    {
-                        let t = start.elapsed().as_secs_f64();
-                        let _ = writeln!(self.out, "{t:9.3} {line}");
-                    }
-                }
+                Ok(event) => self.print(&device, event, start),
                 Err(DriveError::Deadline | DriveError::Stopped) => {}
                 Err(DriveError::Io(e)) => {
                     failures.report(&self.args.iface, &e, &mut *self.err);
                     std::thread::sleep(POLL);
                 }
             }
+        }
+        // Events of the last frame handled (one frame can give several,
+        // and the loop stops between them).
+        while let Some(event) = device.poll_event() {
+            self.print(&device, event, start);
         }
         let _ = self.out.flush();
         if !self.args.quiet {
@@ -301,6 +320,21 @@ impl Session<'_> {
             return ExitCode::from(1);
         }
         ExitCode::SUCCESS
+    }
+
+    /// Prints the line of `event`, if it is notable, with the seconds since
+    /// `start`.
+    fn print<B>(&mut self, device: &Device<B>, event: SimEvent<B::Event>, start: WallClock)
+    where
+        B: Behaviour,
+        B::Event: Describe,
+    {
+        if let Some(line) = self.describe(device, event)
+            && !self.args.quiet
+        {
+            let t = start.elapsed().as_secs_f64();
+            let _ = writeln!(self.out, "{t:9.3} {line}");
+        }
     }
 
     /// The line of one device event, if it is notable.

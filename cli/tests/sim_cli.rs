@@ -40,6 +40,10 @@ fn usage_errors_exit_2() {
             vec!["sim", eds.as_str(), "-i", "can0", "--speed"],
             "--speed",
         ),
+        (
+            vec!["sim", eds.as_str(), "-i", "can0", "--time-scale", "0"],
+            "`0` is not a positive factor",
+        ),
     ] {
         let (code, out, err) = run(&args);
         assert_eq!(code, 2, "{args:?}: {err}");
@@ -57,6 +61,8 @@ fn help_lists_the_options() {
         "-i, --iface <IFACE>",
         "-n, --node <N>",
         "--duration <SECONDS>",
+        "--overlay <YAML>",
+        "--time-scale <F>",
         "-q, --quiet",
         "docs/sim-cli.md",
     ] {
@@ -64,6 +70,34 @@ fn help_lists_the_options() {
     }
     let (_, out, _) = run(&["--help"]);
     assert!(out.contains("sim "), "{out}");
+}
+
+#[test]
+fn an_overlay_that_does_not_read_is_named_with_its_line() {
+    let dir = tempdir();
+    let overlay = dir.join("sim-bad-overlay.yaml");
+    std::fs::write(
+        &overlay,
+        "format: 1\nmodify:\n  - { index: 0x1017, default: 50 }\n  - { index: 0x7777, name: Nowhere }\n",
+    )
+    .unwrap();
+    let overlay = overlay.display().to_string();
+    let (code, out, err) = run(&[
+        "sim",
+        &example(),
+        "--overlay",
+        &overlay,
+        "-i",
+        "nosuchcan0",
+        "-n",
+        "3",
+    ]);
+    assert_eq!(code, 1, "{err}");
+    assert!(out.is_empty(), "{out}");
+    assert!(err.contains(&format!("{overlay}:4:")), "{err}");
+    assert!(err.contains("0x7777"), "{err}");
+    assert!(err.contains("not simulated: 1 errors"), "{err}");
+    assert!(!err.contains("nosuchcan0"), "{err}");
 }
 
 #[test]

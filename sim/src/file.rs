@@ -24,8 +24,9 @@
 use std::fmt;
 use std::path::{Path, PathBuf};
 
+use eds2rust::build::load_device;
 use eds2rust::diag::Severity;
-use eds2rust::input::{Options, read_device};
+use eds2rust::input::Options;
 use eds2rust::ir::{self, Access, Device, Literal, ObjectKind, Value};
 use eds2rust_runtime::cia402::object::{CONTROLWORD, STATUSWORD};
 use eds2rust_runtime::od::{AccessRight, DataType, DefaultValue, NodeId, Number, ObjectInfo};
@@ -108,8 +109,19 @@ impl std::error::Error for LoadError {}
 /// `path` leniently (warnings stay warnings, as `eds2rust check` without
 /// `--strict`) and builds its object table.
 pub fn load(path: impl AsRef<Path>) -> Result<LoadedTable, LoadError> {
+    load_with_overlays(path, &[])
+}
+
+/// [`load`] with the YAML `overlays` (tables without `base:`, as
+/// `eds2rust generate --overlay`) applied on the file in order: names,
+/// defaults, limits, added and deleted objects of the simulated device
+/// come from them. Their diagnostics name the overlay's own file and line.
+pub fn load_with_overlays(
+    path: impl AsRef<Path>,
+    overlays: &[PathBuf],
+) -> Result<LoadedTable, LoadError> {
     let path = path.as_ref();
-    let loaded = read_device(path, &Options::lenient());
+    let loaded = load_device(path, overlays, &Options::lenient());
     let lines = |severity: Severity| -> Vec<String> {
         loaded
             .diagnostics

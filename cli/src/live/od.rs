@@ -6,9 +6,10 @@
 
 use std::cell::OnceCell;
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
-use eds2rust::input::{Options, read_device};
+use eds2rust::build::load_device;
+use eds2rust::input::Options;
 use eds2rust::ir::{Device, Entry, Object, ObjectKind};
 
 use super::LiveError;
@@ -88,7 +89,12 @@ impl Od {
     /// Reads FILE (EDS, DCF or YAML table); errors are usage errors with
     /// the file's diagnostics.
     pub fn load(path: &Path) -> Result<Od, LiveError> {
-        let loaded = read_device(path, &Options::lenient());
+        Od::load_with_overlays(path, &[])
+    }
+
+    /// [`Od::load`] with YAML overlays applied in order.
+    pub fn load_with_overlays(path: &Path, overlays: &[PathBuf]) -> Result<Od, LiveError> {
+        let loaded = load_device(path, overlays, &Options::lenient());
         match loaded.device {
             Some(device) if !loaded.diagnostics.has_errors() => Ok(Od::new(device)),
             _ => {
@@ -244,8 +250,11 @@ impl Od {
     /// `0x1018.1 Identity.Vendor-ID` (or `0x6041 Statusword` for a VAR).
     pub fn label(&self, index: u16, sub: u8) -> String {
         match self.device.objects.get(&index) {
+            // A variable's name is its entry's (an overlay's `modify:`
+            // renames the entry).
             Some(object) if matches!(object.kind, ObjectKind::Var | ObjectKind::Domain) => {
-                format!("{} {}", key(index, sub), object.name)
+                let name = object.entries.get(&0).map_or(&object.name, |e| &e.name);
+                format!("{} {name}", key(index, sub))
             }
             Some(object) => match object.entries.get(&sub) {
                 Some(entry) => format!("{} {}.{}", key(index, sub), object.name, entry.name),

@@ -22,9 +22,11 @@ use crate::live::bus::{self, LiveBus};
 fn args(file: PathBuf, node: u8) -> SimArgs {
     SimArgs {
         file,
+        overlays: Vec::new(),
         iface: "virtual".into(),
         node: Some(node),
         duration: None,
+        time_scale: 1.0,
         quiet: false,
     }
 }
@@ -38,7 +40,8 @@ struct Running {
 
 impl Running {
     fn start(args: SimArgs) -> Running {
-        let table = eds2rust_sim::file::load(&args.file).expect("the file reads");
+        let table = eds2rust_sim::file::load_with_overlays(&args.file, &args.overlays)
+            .expect("the file reads");
         let node = NodeId::new(args.node.unwrap()).unwrap();
         let bus = VirtualBus::new();
         let port = bus.attach();
@@ -189,6 +192,44 @@ fn a_yaml_table_gives_the_node_id_and_a_generic_device() {
     assert!(out.contains("NMT: boot-up -> pre-operational"), "{out}");
     assert!(err.contains(", a generic device; "), "{err}");
     assert!(err.contains("sim: stopped after 0."), "{err}");
+}
+
+/// An overlay turns the heartbeat on (0x1017's default) and names a
+/// manufacturer object the way the integrator's manual does.
+#[test]
+fn an_overlay_changes_defaults_and_names() {
+    let Some(file) = corpus("ros2-canopen_cia402-slave.eds") else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("eds2rust-sim-overlay-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let overlay = dir.join("heartbeat.yaml");
+    std::fs::write(
+        &overlay,
+        "format: 1\nmodify:\n  - { index: 0x1017, default: 50 }\n  - { index: 0x6081, name: Travel speed }\n",
+    )
+    .unwrap();
+    let node = NodeId::new(5).unwrap();
+    let mut a = args(file, 5);
+    a.overlays = vec![overlay];
+    let sim = Running::start(a);
+    let mut tap = sim.bus.attach();
+    let mut m = sim.master(node);
+    assert_eq!(m.upload(node, 0x1017, 0).unwrap(), 50u16.to_le_bytes());
+    let beats = count(&mut tap, 0x705, 0x7F, Duration::from_millis(240));
+    assert!(
+        (3..=6).contains(&beats),
+        "{beats} pre-operational heartbeats"
+    );
+    m.download(node, 0x6081, 0, &1000u32.to_le_bytes()).unwrap();
+    let (code, out, err) = sim.stop();
+    assert_eq!(code, "ExitCode(unix_exit_status(0))", "{err}");
+    assert!(err.contains("heartbeat every 50 ms"), "{err}");
+    assert!(
+        out.contains("SDO write 0x6081 Travel speed := 1000"),
+        "{out}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 impl Running {

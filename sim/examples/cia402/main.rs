@@ -7,8 +7,8 @@
 //! stop. Every state transition is printed, and `target reached at
 //! <position>` after each move; both masters print the same lines.
 //!
-//! `cargo run -p eds2rust-sim --example cia402 -- FILE [--node N]
-//! [--time-scale F] [--trace] [--async]`
+//! `cargo run -p eds2rust-sim --example cia402 -- FILE [--overlay YAML]...
+//! [--node N] [--time-scale F] [--trace] [--async]`
 //!
 //! Exit 0 when all of it worked; 1 with one message naming what the file
 //! lacks (not a CiA 402 drive, no target position, ...) or what failed;
@@ -51,6 +51,8 @@ const POLL: Duration = Duration::from_millis(5);
 pub struct Args {
     /// The device file.
     pub file: PathBuf,
+    /// `--overlay YAML`, in order: YAML overlays applied on the file.
+    pub overlays: Vec<PathBuf>,
     /// `--node N`.
     pub node: Option<u8>,
     /// `--time-scale F`: the simulated mechanics F times faster.
@@ -79,13 +81,15 @@ impl From<std::io::Error> for Failure {
     }
 }
 
-const USAGE: &str = "usage: cia402 FILE [--node N] [--time-scale F] [--trace] [--async]";
+const USAGE: &str =
+    "usage: cia402 FILE [--overlay YAML]... [--node N] [--time-scale F] [--trace] [--async]";
 
 /// Parses the arguments after the program name.
 pub fn parse(args: impl IntoIterator<Item = String>) -> Result<Args, Failure> {
     let mut file = None;
     let mut out = Args {
         file: PathBuf::new(),
+        overlays: Vec::new(),
         node: None,
         time_scale: 1.0,
         trace: false,
@@ -96,6 +100,10 @@ pub fn parse(args: impl IntoIterator<Item = String>) -> Result<Args, Failure> {
         match arg.as_str() {
             "--trace" => out.trace = true,
             "--async" => out.asynchronous = true,
+            "--overlay" => match args.next() {
+                Some(path) => out.overlays.push(PathBuf::from(path)),
+                None => return Err(Failure(format!("--overlay needs a YAML file\n{USAGE}"))),
+            },
             "--node" => {
                 let value = args.next().unwrap_or_default();
                 let node = value
@@ -196,7 +204,8 @@ fn session_config() -> SessionConfig {
 
 /// Runs the scenario on the file `args.file`, printing to `out`.
 pub fn run(args: &Args, out: &mut dyn std::io::Write) -> Result<Summary, Failure> {
-    let table = file::load(&args.file).map_err(|e| Failure(e.to_string()))?;
+    let table =
+        file::load_with_overlays(&args.file, &args.overlays).map_err(|e| Failure(e.to_string()))?;
     check(&table)?;
     let file = table.path.display().to_string();
     let node = args
@@ -539,6 +548,7 @@ mod tests {
     fn args(file: PathBuf) -> Args {
         Args {
             file,
+            overlays: Vec::new(),
             node: None,
             time_scale: 20.0,
             trace: false,
@@ -593,10 +603,39 @@ mod tests {
         );
     }
 
+    /// An overlay that deletes 0x607A: the runtime's check refuses profile
+    /// position before any frame, naming the object.
+    #[test]
+    fn an_overlay_applies_and_a_missing_object_is_named() {
+        let Some(file) = corpus("cia402_sample.eds") else {
+            return;
+        };
+        let dir = std::env::temp_dir().join(format!("eds2rust-cia402-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let overlay = dir.join("no-target.yaml");
+        std::fs::write(&overlay, "format: 1\ndelete:\n  - { index: 0x607A }\n").unwrap();
+        let mut a = args(file);
+        a.overlays = vec![overlay];
+        for asynchronous in [false, true] {
+            a.asynchronous = asynchronous;
+            let e = run(&a, &mut Vec::new()).expect_err("refused");
+            assert!(
+                e.0.ends_with(
+                    "profile position needs 0x607A Target position, which this device does not have"
+                ),
+                "{e}"
+            );
+        }
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
     #[test]
     fn the_command_line() {
-        let a = parse(["f.eds", "--node", "9", "--async"].map(String::from)).expect("parses");
+        let a = parse(["f.eds", "--node", "9", "--async", "--overlay", "o.yaml"].map(String::from))
+            .expect("parses");
         assert_eq!((a.node, a.asynchronous), (Some(9), true));
+        assert_eq!(a.overlays, [PathBuf::from("o.yaml")]);
+        assert!(parse(["f.eds", "--overlay"].map(String::from)).is_err());
         assert!(parse(["--node", "0", "f.eds"].map(String::from)).is_err());
         assert!(parse(["f.eds", "g.eds"].map(String::from)).is_err());
         assert!(parse(Vec::<String>::new()).is_err());
