@@ -640,6 +640,11 @@ pub(super) fn modify(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>
     }
     check_limits(ctx, &entry, def, &here);
     if let Some(object) = device.objects.get_mut(&index) {
+        // A variable is its one entry: renaming it renames the object (the
+        // name `od::OBJECTS`, the decoder and the CLI show).
+        if matches!(object.kind, ObjectKind::Var | ObjectKind::Domain) && d.name.is_some() {
+            object.name = entry.name.clone();
+        }
         object.entries.insert(sub, entry);
     }
 }
