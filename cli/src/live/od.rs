@@ -250,11 +250,8 @@ impl Od {
     /// `0x1018.1 Identity.Vendor-ID` (or `0x6041 Statusword` for a VAR).
     pub fn label(&self, index: u16, sub: u8) -> String {
         match self.device.objects.get(&index) {
-            // A variable's name is its entry's (an overlay's `modify:`
-            // renames the entry).
             Some(object) if matches!(object.kind, ObjectKind::Var | ObjectKind::Domain) => {
-                let name = object.entries.get(&0).map_or(&object.name, |e| &e.name);
-                format!("{} {name}", key(index, sub))
+                format!("{} {}", key(index, sub), object.name)
             }
             Some(object) => match object.entries.get(&sub) {
                 Some(entry) => format!("{} {}.{}", key(index, sub), object.name, entry.name),
