@@ -164,3 +164,73 @@ fn overlay_stages_take_effect_and_leave_the_rest_alone() {
 fn canonical(path: &str) -> std::path::PathBuf {
     std::fs::canonicalize(path).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
+
+/// `modify:` renaming a manufacturer variable renames the object as a
+/// whole: `od::OBJECTS` and the entry's `NAME` say the new name, and its
+/// Rust name follows the new name unless `rust_name:` pins it (as a
+/// renamed sub-entry's does). Nothing else of the listing changes.
+#[test]
+fn renaming_a_variable_renames_its_object_and_rust_name_unless_pinned() {
+    let Some(shared) = shared_dir() else {
+        not_run("overlay rename test: ../shared/eds-corpus is not beside this checkout");
+        return;
+    };
+    let base = shared.join("eds-corpus/files/canfestival_led.eds");
+    let dir = std::env::temp_dir().join(format!("eds2rust-rename-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, text: &str| {
+        let path = dir.join(name);
+        std::fs::write(&path, text).unwrap();
+        path
+    };
+    let rename = write(
+        "rename.yaml",
+        "format: 1\nmodify:\n  - { index: 0x2001, name: Bus speed }\n",
+    );
+    let pin = write(
+        "pin.yaml",
+        "format: 1\nmodify:\n  - { index: 0x2001, name: Bus speed, rust_name: CanBitrateKbit }\n",
+    );
+    let listing = |overlay: Option<&std::path::PathBuf>| {
+        let overlays: Vec<std::path::PathBuf> = overlay.cloned().into_iter().collect();
+        eds2rust::build::api_listing_files(&base, &overlays, &Options::lenient())
+            .unwrap_or_else(|d| panic!("{}", d.render()))
+            .text
+    };
+    let before = listing(None);
+    let renamed = listing(Some(&rename));
+    let pinned = listing(Some(&pin));
+    let line = |text: &str| {
+        text.lines()
+            .find(|l| l.contains("\t0x2001\t"))
+            .expect("0x2001 listed")
+            .to_string()
+    };
+    assert!(
+        line(&before).starts_with("od::CanBitrateKbit\t"),
+        "{}",
+        line(&before)
+    );
+    assert!(
+        line(&renamed).starts_with("od::BusSpeed\t"),
+        "{}",
+        line(&renamed)
+    );
+    assert_eq!(line(&pinned), line(&before));
+    let others = |text: &str| -> Vec<String> {
+        text.lines()
+            .filter(|l| !l.contains("\t0x2001\t"))
+            .map(String::from)
+            .collect()
+    };
+    assert_eq!(others(&renamed), others(&before));
+    assert_eq!(pinned, before);
+
+    // The object table and the decoder's name are the new one too.
+    let loaded =
+        eds2rust::build::load_device(&base, std::slice::from_ref(&rename), &Options::lenient());
+    let device = loaded.device.expect("reads");
+    assert_eq!(device.objects[&0x2001].name, "Bus speed");
+    assert_eq!(device.objects[&0x2001].entries[&0].name, "Bus speed");
+    let _ = std::fs::remove_dir_all(&dir);
+}
