@@ -193,32 +193,33 @@ BUILD=$VM/cargo
 TESTBIN=$VM/tests
 EXBIN=$VM/examples
 CLIBIN=$VM/cli
+# `cargo build` of static binaries for the VM, in the dev profile without
+# debug info (half the time of release, small binaries) and without
+# incremental caches (a build from scratch has no use for them, and they
+# were more than half of $BUILD).
+static_build() {
+    (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
+        CARGO_PROFILE_DEV_DEBUG=false CARGO_INCREMENTAL=0 \
+        cargo build --target "$TRIPLE" --target-dir "$BUILD" "$@")
+}
 build_tests() {
     say "building static test binaries"
     local json=$VM/cargo.json
-    # The dev profile without debug info: builds in half the time of
-    # release, and the binary stays small.
-    (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
-        CARGO_PROFILE_DEV_DEBUG=false cargo build --target "$TRIPLE" --target-dir "$BUILD" \
-        -p eds2rust-runtime --features socketcan,tokio --test socketcan_vcan \
-        --message-format=json-render-diagnostics >"$json") ||
+    static_build -p eds2rust-runtime --features socketcan,tokio --test socketcan_vcan \
+        --message-format=json-render-diagnostics >"$json" ||
         infra "cargo build of the static test binaries failed"
     # python-canopen against our runtime over vcan (tests/tests/vcan_python.rs).
     local pyjson=$VM/cargo-python.json
-    (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
-        CARGO_PROFILE_DEV_DEBUG=false cargo build --target "$TRIPLE" --target-dir "$BUILD" \
-        -p eds2rust-tests --test vcan_python \
-        --message-format=json-render-diagnostics >"$pyjson") ||
+    static_build -p eds2rust-tests --test vcan_python \
+        --message-format=json-render-diagnostics >"$pyjson" ||
         infra "cargo build of the static python-canopen test binary failed"
     # The CLI's live-bus commands (cli/tests/live_vcan.rs), `eds2rust
     # monitor` (cli/tests/monitor_vcan.rs) and `eds2rust sim`
     # (cli/tests/sim_vcan.rs), and the eds2rust binary they run, against the
     # seed-device simulators and python-canopen.
     local clijson=$VM/cargo-cli.json
-    (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
-        CARGO_PROFILE_DEV_DEBUG=false cargo build --target "$TRIPLE" --target-dir "$BUILD" \
-        -p eds2rust-cli --bin eds2rust --test live_vcan --test monitor_vcan --test sim_vcan \
-        --message-format=json-render-diagnostics >"$clijson") ||
+    static_build -p eds2rust-cli --bin eds2rust --test live_vcan --test monitor_vcan --test sim_vcan \
+        --message-format=json-render-diagnostics >"$clijson" ||
         infra "cargo build of the static CLI and its live-bus tests failed"
     local cli
     cli=$(grep '"reason":"compiler-artifact"' "$clijson" | grep '"kind":\["bin"\]' |
@@ -229,11 +230,9 @@ build_tests() {
     # The seed-device examples, each run in the VM with its simulator on its
     # own vcan interface: NMT, heartbeat, SDO, PDO (and LSS) over the kernel.
     local exjson=$VM/cargo-examples.json
-    (cd "$ROOT" && RUSTFLAGS="${RUSTFLAGS:-} -C target-feature=+crt-static" \
-        CARGO_PROFILE_DEV_DEBUG=false cargo build --target "$TRIPLE" --target-dir "$BUILD" \
-        -p eds2rust-sim --example zimmer_acs --example linak_techline \
+    static_build -p eds2rust-sim --example zimmer_acs --example linak_techline \
         --example interroll_ec5000bi \
-        --message-format=json-render-diagnostics >"$exjson") ||
+        --message-format=json-render-diagnostics >"$exjson" ||
         infra "cargo build of the static example binaries failed"
     rm -rf "$EXBIN" && mkdir -p "$EXBIN"
     while read -r exe; do
