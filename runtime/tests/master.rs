@@ -137,6 +137,9 @@ impl Rig {
             }
         }));
 
+        // The master's port is attached before the device starts, or the
+        // device's boot-up can go out before anyone listens.
+        let master_port = bus.attach();
         let mut port = bus.attach();
         let halt = stop.clone();
         threads.push(thread::spawn(move || {
@@ -167,7 +170,7 @@ impl Rig {
         let mut core = master::Master::new(node(1), PERIOD);
         core.consumer
             .monitor(node(DEVICE), Duration::from_millis(200));
-        let mut master = Master::new(bus.attach(), core);
+        let mut master = Master::new(master_port, core);
         master.start().unwrap();
         Rig {
             bus,
