@@ -17,7 +17,7 @@ use eds2rust_runtime::cia402::{
     DeviceConfig, Event, ModeOfOperation, Move, OperationError, SessionConfig, State, Step,
 };
 use eds2rust_runtime::master;
-use eds2rust_runtime::od::{AccessRight, DataType, NodeId, ObjectInfo};
+use eds2rust_runtime::od::{DataType, NodeId, ObjectInfo};
 use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::server::{SdoServer, ServerConfig};
 use eds2rust_runtime::transport::Clock;
@@ -28,7 +28,7 @@ mod sim;
 
 const NODE: u8 = 0x20;
 
-use sim::{DeviceNode, DriveStore, FULL, NO_VELOCITY, SETTLE, Sim, fast_config, rw, states};
+use sim::{DeviceNode, DriveStore, FULL, NO_VELOCITY, SETTLE, Sim, fast_config, ro, rw, states};
 
 fn node() -> NodeId {
     NodeId::new(NODE).unwrap()
@@ -367,14 +367,7 @@ fn an_sdo_abort_names_the_object() {
     // The table claims the motion profile objects, the drive has none.
     static CLAIMS_MORE: [ObjectInfo; 5] = [
         rw(0x6040, "Controlword", DataType::Unsigned16),
-        ObjectInfo::new(
-            0x6041,
-            0,
-            "Statusword",
-            DataType::Unsigned16,
-            AccessRight::Ro,
-            true,
-        ),
+        ro(0x6041, "Statusword", DataType::Unsigned16),
         rw(0x6081, "Profile velocity", DataType::Unsigned32),
         rw(0x6083, "Profile acceleration", DataType::Unsigned32),
         rw(0x6084, "Profile deceleration", DataType::Unsigned32),

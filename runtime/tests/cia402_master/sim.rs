@@ -25,50 +25,27 @@ pub const fn rw(index: u16, name: &'static str, data_type: DataType) -> ObjectIn
     ObjectInfo::new(index, 0, name, data_type, AccessRight::Rw, true)
 }
 
+/// A read-only, mappable variable of the table.
+pub const fn ro(index: u16, name: &'static str, data_type: DataType) -> ObjectInfo {
+    ObjectInfo::new(index, 0, name, data_type, AccessRight::Ro, true)
+}
+
 /// The full table of the simulated drive.
 pub static FULL: [ObjectInfo; 8] = [
-    ObjectInfo::new(
-        0x603F,
-        0,
-        "Error code",
-        DataType::Unsigned16,
-        AccessRight::Ro,
-        true,
-    ),
+    ro(0x603F, "Error code", DataType::Unsigned16),
     rw(0x6040, "Controlword", DataType::Unsigned16),
-    ObjectInfo::new(
-        0x6041,
-        0,
-        "Statusword",
-        DataType::Unsigned16,
-        AccessRight::Ro,
-        true,
-    ),
+    ro(0x6041, "Statusword", DataType::Unsigned16),
     rw(0x6060, "Modes of operation", DataType::Integer8),
     rw(0x607A, "Target position", DataType::Integer32),
     rw(0x6098, "Homing method", DataType::Integer8),
     rw(0x60FF, "Target velocity", DataType::Integer32),
-    ObjectInfo::new(
-        0x6061,
-        0,
-        "Modes of operation display",
-        DataType::Integer8,
-        AccessRight::Ro,
-        true,
-    ),
+    ro(0x6061, "Modes of operation display", DataType::Integer8),
 ];
 
 /// A table without 0x60FF (a drive without profile velocity).
 pub static NO_VELOCITY: [ObjectInfo; 5] = [
     rw(0x6040, "Controlword", DataType::Unsigned16),
-    ObjectInfo::new(
-        0x6041,
-        0,
-        "Statusword",
-        DataType::Unsigned16,
-        AccessRight::Ro,
-        true,
-    ),
+    ro(0x6041, "Statusword", DataType::Unsigned16),
     rw(0x6060, "Modes of operation", DataType::Integer8),
     rw(0x607A, "Target position", DataType::Integer32),
     rw(0x6098, "Homing method", DataType::Integer8),
