@@ -25,7 +25,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant as WallClock};
 
 use clap::Args;
-use eds2rust_runtime::blocking::{self, DriveError};
+use eds2rust_runtime::blocking::{self, RunError};
 use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::sdo::server::ServerEvent;
 use eds2rust_runtime::transport::{Bus, Clock};
@@ -283,19 +283,20 @@ impl Session<'_> {
         let deadline = self.args.duration.map(|d| start + d);
         while !self.stop.load(Ordering::Relaxed) && deadline.is_none_or(|d| WallClock::now() < d) {
             let until: Instant = self.clock.now() + POLL;
-            match blocking::drive(
+            match blocking::run(
                 &mut *self.bus,
                 &self.clock,
                 &mut device,
-                ControlFlow::Break,
                 until,
+                ControlFlow::Break,
             ) {
                 Ok(event) => self.print(&device, event, start),
-                Err(DriveError::Deadline | DriveError::Stopped) => {}
-                Err(DriveError::Io(e)) => {
+                Err(RunError::Io(e)) => {
                     failures.report(&self.args.iface, &e, &mut *self.err);
                     std::thread::sleep(POLL);
                 }
+                // The deadline of this round passed.
+                Err(_) => {}
             }
         }
         // Events of the last frame handled (one frame can give several,

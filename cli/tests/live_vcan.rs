@@ -186,7 +186,7 @@ fn nmt_and_scan_find_the_node_with_its_identity() {
         "sent NMT reset communication to node 32\nnode 32: boot-up seen\n"
     );
     assert_eq!(
-        ok(&["nmt", "stop", "-i", &i]),
+        ok(&["nmt", "stop", "-i", &i, "--all"]),
         "sent NMT stop to all nodes\n"
     );
     // No node 33: nothing confirms.

@@ -95,7 +95,10 @@ impl Decoder {
             Function::Nmt => {
                 rec.kind = match nmt::parse_command(frame) {
                     Some((command, target)) => {
-                        rec.node = target.map(|n| n.get());
+                        rec.node = match target {
+                            nmt::NmtTarget::Node(n) => Some(n.get()),
+                            nmt::NmtTarget::All => None,
+                        };
                         Kind::Nmt {
                             command,
                             target: rec.node,

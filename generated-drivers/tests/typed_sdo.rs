@@ -93,11 +93,17 @@ fn generated_entries_read_and_write_through_the_sdo_client() {
 
     // The server's refusals come back as typed aborts.
     match client.download(0x2001, 1, &[0, 0]) {
-        Err(Error::Sdo(SdoError::RemoteAbort(AbortCode::WriteReadOnly))) => {}
+        Err(Error::Sdo {
+            error: SdoError::RemoteAbort(AbortCode::WriteReadOnly),
+            ..
+        }) => {}
         other => panic!("writing the read-only feedback position gave {other:?}"),
     }
     match client.upload(0x2003, 0) {
-        Err(Error::Sdo(SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist))) => {}
+        Err(Error::Sdo {
+            error: SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist),
+            ..
+        }) => {}
         other => panic!("reading a missing object gave {other:?}"),
     }
 

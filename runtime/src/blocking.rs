@@ -1,6 +1,6 @@
 //! Blocking drivers: run sans-IO cores over a [`Bus`] on the calling thread.
 //!
-//! - [`drive`] runs any [`Service`] until a closure over its events says
+//! - [`run`] runs any [`Service`] until a closure over its events says
 //!   stop, or a deadline passes; [`serve`] runs one until a stop flag is set
 //!   (simulators, test peers).
 //! - [`SdoClient`] reads and writes objects of one node through
@@ -16,10 +16,11 @@ use std::string::String;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::vec::Vec;
 
-use crate::od::{self, Entry};
+use crate::frame::CanId;
+use crate::od::{self, Entry, NodeId};
 use crate::sdo::client::{self, ClientConfig, ClientEvent, Method};
 use crate::sdo::typed::{self, LengthNote};
-use crate::sdo::{AbortCode, SdoError};
+use crate::sdo::{AbortCode, Channel, SdoError};
 pub use crate::time::Deadline;
 use crate::transport::{Bus, Clock};
 use crate::{Instant, Service};
@@ -27,9 +28,7 @@ use crate::{Instant, Service};
 mod error;
 pub(crate) mod master;
 pub(crate) mod stream;
-pub use master::{
-    Cia402Error, DRIVE_EVENTS_KEPT, DriveHandle, LssRequestError, MASTER_QUEUE_CAPACITY, Master,
-};
+pub use master::{DRIVE_EVENTS_KEPT, DriveHandle, LssRequestError, MASTER_QUEUE_CAPACITY, Master};
 
 /// How often [`serve`] looks at its stop flag while nothing happens.
 pub const STOP_POLL: Duration = Duration::from_millis(10);
@@ -37,9 +36,10 @@ pub const STOP_POLL: Duration = Duration::from_millis(10);
 /// Longest single wait when neither the core nor the caller set a deadline.
 const IDLE_WAIT: Duration = Duration::from_secs(1);
 
-/// Why [`drive`] returned without a result.
+/// Why [`run`] returned without a result.
 #[derive(Debug)]
-pub enum DriveError {
+#[non_exhaustive]
+pub enum RunError {
     /// The bus failed.
     Io(io::Error),
     /// The deadline passed.
@@ -48,20 +48,20 @@ pub enum DriveError {
     Stopped,
 }
 
-impl fmt::Display for DriveError {
+impl fmt::Display for RunError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            DriveError::Io(e) => write!(f, "CAN bus error: {e}"),
-            DriveError::Deadline => f.write_str("the deadline passed"),
-            DriveError::Stopped => f.write_str("stopped"),
+            RunError::Io(e) => write!(f, "CAN bus error: {e}"),
+            RunError::Deadline => f.write_str("the deadline passed"),
+            RunError::Stopped => f.write_str("stopped"),
         }
     }
 }
 
-impl std::error::Error for DriveError {
+impl std::error::Error for RunError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {
-            DriveError::Io(e) => Some(e),
+            RunError::Io(e) => Some(e),
             _ => None,
         }
     }
@@ -70,7 +70,8 @@ impl std::error::Error for DriveError {
 /// Runs `service` on `bus`: sends what it transmits, feeds it every
 /// received frame and its timeouts (times from `clock`), and hands each of
 /// its events to `until`. Returns the value `until` breaks with, or
-/// [`DriveError::Deadline`] once `deadline` passes first.
+/// [`RunError::Deadline`] once `deadline` passes first. The deadline comes
+/// before the closure, as in [`serve`] and [`Master::run_until`].
 ///
 /// `deadline` is a point in time: an [`Instant`] of the cores
 /// (`clock.now() + Duration::from_millis(50)`), a `std::time::Instant` or
@@ -78,19 +79,19 @@ impl std::error::Error for DriveError {
 ///
 /// Events left in the service when `until` breaks stay there for the next
 /// call.
-pub fn drive<B, S, T>(
+pub fn run<B, S, T>(
     bus: &mut B,
     clock: &Clock,
     service: &mut S,
-    mut until: impl FnMut(S::Event) -> ControlFlow<T>,
     deadline: impl Into<Deadline>,
-) -> Result<T, DriveError>
+    mut until: impl FnMut(S::Event) -> ControlFlow<T>,
+) -> Result<T, RunError>
 where
     B: Bus + ?Sized,
     S: Service + ?Sized,
 {
     let deadline = deadline.into().on(clock);
-    run(
+    run_loop(
         bus,
         clock,
         service,
@@ -101,7 +102,7 @@ where
     )
 }
 
-/// Runs `service` on `bus` (as [`drive`] does) until `stop` is set or
+/// Runs `service` on `bus` (as [`run`] does) until `stop` is set or
 /// `deadline` passes, handing every event to `on_event`. `stop` is checked
 /// at least every [`STOP_POLL`]. Returns `Ok(())` when stopped or past the
 /// deadline, the bus error otherwise.
@@ -127,7 +128,7 @@ where
     };
     let deadline = deadline.into().on(clock);
     let mut no_hook = |_: &mut S, _| ControlFlow::Continue(());
-    match run(
+    match run_loop(
         bus,
         clock,
         service,
@@ -136,15 +137,15 @@ where
         Some(stop),
         &mut no_hook,
     ) {
-        Ok(()) | Err(DriveError::Deadline | DriveError::Stopped) => Ok(()),
-        Err(DriveError::Io(e)) => Err(e),
+        Ok(()) | Err(RunError::Deadline | RunError::Stopped) => Ok(()),
+        Err(RunError::Io(e)) => Err(e),
     }
 }
 
-/// The loop behind [`drive`] and [`serve`], in the cores' time. `hook`
+/// The loop behind [`run`] and [`serve`], in the cores' time. `hook`
 /// runs first in every round (streamed transfers feed and take data
-/// there); breaking from it stops the loop with [`DriveError::Stopped`].
-pub(crate) fn run<B, S, T>(
+/// there); breaking from it stops the loop with [`RunError::Stopped`].
+pub(crate) fn run_loop<B, S, T>(
     bus: &mut B,
     clock: &Clock,
     service: &mut S,
@@ -152,17 +153,17 @@ pub(crate) fn run<B, S, T>(
     deadline: Option<Instant>,
     stop: Option<&AtomicBool>,
     hook: &mut dyn FnMut(&mut S, Instant) -> ControlFlow<()>,
-) -> Result<T, DriveError>
+) -> Result<T, RunError>
 where
     B: Bus + ?Sized,
     S: Service + ?Sized,
 {
     loop {
         if hook(service, clock.now()).is_break() {
-            return Err(DriveError::Stopped);
+            return Err(RunError::Stopped);
         }
         while let Some(frame) = service.poll_transmit() {
-            bus.send(&frame).map_err(DriveError::Io)?;
+            bus.send(&frame).map_err(RunError::Io)?;
         }
         while let Some(event) = service.poll_event() {
             if let ControlFlow::Break(value) = until(event) {
@@ -170,11 +171,11 @@ where
             }
         }
         if stop.is_some_and(|stop| stop.load(Ordering::Relaxed)) {
-            return Err(DriveError::Stopped);
+            return Err(RunError::Stopped);
         }
         let now = clock.now();
         if deadline.is_some_and(|deadline| now >= deadline) {
-            return Err(DriveError::Deadline);
+            return Err(RunError::Deadline);
         }
         let timer = service.poll_timeout();
         if let Some(at) = timer
@@ -190,13 +191,64 @@ where
         if stop.is_some() {
             wake = wake.min(now + STOP_POLL);
         }
-        if let Some(frame) = bus.recv(wake - now).map_err(DriveError::Io)? {
+        if let Some(frame) = bus.recv(wake - now).map_err(RunError::Io)? {
             service.handle_frame(clock.now(), &frame);
         }
     }
 }
 
 pub use error::Error;
+
+/// The object a transfer is about, named in its errors.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Object {
+    pub(crate) node: Option<NodeId>,
+    pub(crate) index: u16,
+    pub(crate) sub: u8,
+}
+
+impl Object {
+    pub(crate) fn new(node: Option<NodeId>, index: u16, sub: u8) -> Object {
+        Object { node, index, sub }
+    }
+
+    /// The transfer failed with `error`.
+    pub(crate) fn sdo(self, error: SdoError) -> Error {
+        let Object { node, index, sub } = self;
+        Error::Sdo {
+            node,
+            index,
+            sub,
+            error,
+        }
+    }
+
+    /// The value had the wrong length.
+    pub(crate) fn value(self, error: od::ValueError) -> Error {
+        let Object { node, index, sub } = self;
+        Error::Value {
+            node,
+            index,
+            sub,
+            error,
+        }
+    }
+
+    /// The client core is busy.
+    pub(crate) fn busy(self) -> Error {
+        Error::SdoBusy { node: self.node }
+    }
+}
+
+/// The node whose default SDO channel `channel` is (0x600 + node to the
+/// server, 0x580 + node back); `None` for any other channel.
+pub(crate) fn channel_node(channel: Channel) -> Option<NodeId> {
+    let CanId::Standard(request) = channel.request else {
+        return None;
+    };
+    let node = NodeId::new(u8::try_from(request.checked_sub(0x600)?).ok()?)?;
+    (Channel::default_for(node) == channel).then_some(node)
+}
 
 /// The transfer a driver call runs.
 #[derive(Debug, Clone, Copy)]
@@ -206,22 +258,22 @@ pub(crate) enum Transfer<'a> {
 }
 
 impl Transfer<'_> {
-    /// Starts the transfer on the core.
+    /// Starts the transfer of `object` on the core.
     pub(crate) fn start(
         self,
         core: &mut client::SdoClient,
         now: Instant,
-        index: u16,
-        sub: u8,
+        object: Object,
     ) -> Result<(), Error> {
         // Events of earlier transfers (there are none unless a call was cut
         // short) would make the core refuse.
         while core.poll_event().is_some() {}
+        let (index, sub) = (object.index, object.sub);
         match self {
             Transfer::Upload(method) => core.upload_with(now, index, sub, method),
             Transfer::Download(data, method) => core.download_with(now, index, sub, data, method),
         }
-        .map_err(|client::Busy| Error::Busy)
+        .map_err(|client::Busy| object.busy())
     }
 
     /// An upper bound of the transfer's duration when the server answers
@@ -247,44 +299,62 @@ pub(crate) struct Upload {
     pub(crate) padded: bool,
 }
 
-/// The value `drive`'s closure breaks with once the transfer of (index,
-/// sub) ended: the uploaded data (empty for downloads) or the error.
+/// The value the run's closure breaks with once the transfer of `object`
+/// ended: the uploaded data (empty for downloads) or the error.
 pub(crate) fn transfer_end(
     event: ClientEvent,
-    index: u16,
-    sub: u8,
+    object: Object,
 ) -> ControlFlow<Result<Upload, Error>> {
+    let this = |i: u16, s: u8| (i, s) == (object.index, object.sub);
     match event {
         ClientEvent::Uploaded {
-            index: i,
-            sub: s,
+            index,
+            sub,
             data,
             padded,
-        } if (i, s) == (index, sub) => ControlFlow::Break(Ok(Upload { data, padded })),
-        ClientEvent::Downloaded { index: i, sub: s } if (i, s) == (index, sub) => {
+        } if this(index, sub) => ControlFlow::Break(Ok(Upload { data, padded })),
+        ClientEvent::Downloaded { index, sub } if this(index, sub) => {
             ControlFlow::Break(Ok(Upload {
                 data: Vec::new(),
                 padded: false,
             }))
         }
-        ClientEvent::Failed {
-            index: i,
-            sub: s,
-            error,
-        } if (i, s) == (index, sub) => ControlFlow::Break(Err(Error::Sdo(error))),
+        ClientEvent::Failed { index, sub, error } if this(index, sub) => {
+            ControlFlow::Break(Err(object.sdo(error)))
+        }
         _ => ControlFlow::Continue(()),
     }
 }
 
-/// Ends a transfer the driver gives up on: aborts it on the core (the
-/// caller then sends the abort frame) and drops its events. Returns the
-/// error to report.
-pub(crate) fn give_up(core: &mut client::SdoClient, error: DriveError) -> Error {
+/// Ends a transfer of `object` the driver gives up on: aborts it on the
+/// core (the caller then sends the abort frame) and drops its events.
+/// `limit` is the bound on the whole transfer the run's deadline stood
+/// for. Returns the error to report.
+pub(crate) fn give_up(
+    core: &mut client::SdoClient,
+    error: RunError,
+    object: Object,
+    limit: Option<Duration>,
+) -> Error {
     let (code, error) = match error {
-        DriveError::Io(e) => (AbortCode::GeneralError, Error::Io(e)),
-        DriveError::Deadline | DriveError::Stopped => {
-            (AbortCode::Timeout, Error::Sdo(SdoError::Timeout))
+        RunError::Io(e) => (AbortCode::GeneralError, Error::Io(e)),
+        RunError::Deadline => {
+            let Object { node, index, sub } = object;
+            let error = match limit {
+                Some(limit) => Error::TransferTooLong {
+                    node,
+                    index,
+                    sub,
+                    limit,
+                },
+                None => object.sdo(SdoError::Timeout),
+            };
+            (AbortCode::Timeout, error)
         }
+        RunError::Stopped => (
+            AbortCode::Timeout,
+            object.sdo(SdoError::LocalAbort(AbortCode::Timeout)),
+        ),
     };
     if !core.is_idle() {
         core.abort(code);
@@ -293,32 +363,37 @@ pub(crate) fn give_up(core: &mut client::SdoClient, error: DriveError) -> Error 
     error
 }
 
-/// A VISIBLE_STRING value: the bytes before the first NUL (CiA 301 allows
-/// NUL as padding), each a visible character 0x20 to 0x7E.
-pub(crate) fn visible_string(mut data: Vec<u8>) -> Result<String, Error> {
+/// A VISIBLE_STRING value of `object`: the bytes before the first NUL
+/// (CiA 301 allows NUL as padding), each a visible character 0x20 to 0x7E.
+pub(crate) fn visible_string(mut data: Vec<u8>, object: Object) -> Result<String, Error> {
     if let Some(end) = data.iter().position(|&b| b == 0) {
         data.truncate(end);
     }
+    let not_visible = |offset, byte| Error::NotVisible {
+        node: object.node,
+        index: object.index,
+        sub: object.sub,
+        offset,
+        byte,
+    };
     if let Some(offset) = data.iter().position(|b| !(0x20..=0x7E).contains(b)) {
         let byte = data.get(offset).copied().unwrap_or(0);
-        return Err(Error::NotVisible { offset, byte });
+        return Err(not_visible(offset, byte));
     }
     // Every byte is ASCII, so this never fails.
-    String::from_utf8(data).map_err(|e| Error::NotVisible {
-        offset: e.utf8_error().valid_up_to(),
-        byte: 0,
-    })
+    String::from_utf8(data).map_err(|e| not_visible(e.utf8_error().valid_up_to(), 0))
 }
 
-/// The bus form of a typed value: a buffer and its used length.
-pub(crate) fn encode<E>(value: E::Value) -> Result<([u8; 8], usize), Error>
+/// The bus form of a typed value for `object`: a buffer and its used
+/// length.
+pub(crate) fn encode<E>(value: E::Value, object: Object) -> Result<([u8; 8], usize), Error>
 where
     E: Entry,
     E::Access: od::Write,
     E::Value: od::Scalar,
 {
     let mut buf = [0u8; 8];
-    let len = od::encode_value::<E>(value, &mut buf)?;
+    let len = od::encode_value::<E>(value, &mut buf).map_err(|e| object.value(e))?;
     Ok((buf, len))
 }
 
@@ -380,15 +455,27 @@ impl<B: Bus> SdoClient<B> {
         self.bus
     }
 
+    /// The object (index, sub) of this client's node.
+    pub(crate) fn object(&self, index: u16, sub: u8) -> Object {
+        Object::new(channel_node(self.core.config().channel), index, sub)
+    }
+
     fn transfer(&mut self, index: u16, sub: u8, transfer: Transfer<'_>) -> Result<Upload, Error> {
         let now = self.clock.now();
-        transfer.start(&mut self.core, now, index, sub)?;
-        let deadline = now + transfer.bound(self.core.config());
-        let until = |event| transfer_end(event, index, sub);
-        match drive(&mut self.bus, &self.clock, &mut self.core, until, deadline) {
+        let object = self.object(index, sub);
+        transfer.start(&mut self.core, now, object)?;
+        let limit = transfer.bound(self.core.config());
+        let until = |event| transfer_end(event, object);
+        match run(
+            &mut self.bus,
+            &self.clock,
+            &mut self.core,
+            now + limit,
+            until,
+        ) {
             Ok(result) => result,
             Err(e) => {
-                let error = give_up(&mut self.core, e);
+                let error = give_up(&mut self.core, e, object, Some(limit));
                 while let Some(frame) = self.core.poll_transmit() {
                     // Best effort: the abort frame of a failing bus may not go.
                     let _ = self.bus.send(&frame);
@@ -474,7 +561,8 @@ impl<B: Bus> SdoClient<B> {
         E: Entry<Value = od::bytes::VisibleString>,
         E::Access: od::Read,
     {
-        visible_string(self.upload(E::INDEX, E::SUBINDEX)?)
+        let data = self.upload(E::INDEX, E::SUBINDEX)?;
+        visible_string(data, self.object(E::INDEX, E::SUBINDEX))
     }
 
     /// Writes the bytes of a string, DOMAIN or other byte-valued entry.
@@ -539,7 +627,8 @@ impl<B: Bus> SdoClient<B> {
     {
         let upload = self.transfer(E::INDEX, sub, Transfer::Upload(Method::Auto))?;
         let strict = self.core.config().strict_lengths;
-        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)?;
+        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)
+            .map_err(|e| self.object(E::INDEX, sub).value(e))?;
         if let Some(note) = note {
             typed::keep(&mut self.notes, note);
         }
@@ -553,7 +642,7 @@ impl<B: Bus> SdoClient<B> {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value)?;
+        let (buf, len) = encode::<E>(value, self.object(E::INDEX, sub))?;
         self.download(E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
     }
 }

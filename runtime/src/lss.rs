@@ -41,6 +41,33 @@ pub const fn node_id_byte(node: Option<NodeId>) -> u8 {
     }
 }
 
+/// The node id a configure-node-id request gives the slave: a node id, or,
+/// spelled out, none ([`UNCONFIGURED`]). An invalid id never turns into
+/// "unconfigured": [`NodeId`] holds only 1 to 127.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum LssNodeId {
+    /// Node id 1 to 127.
+    Node(NodeId),
+    /// No node id: the slave becomes unconfigured (0xFF).
+    Unconfigured,
+}
+
+impl LssNodeId {
+    /// The node id byte of the request.
+    pub const fn to_byte(self) -> u8 {
+        match self {
+            LssNodeId::Node(node) => node.get(),
+            LssNodeId::Unconfigured => UNCONFIGURED,
+        }
+    }
+}
+
+impl From<NodeId> for LssNodeId {
+    fn from(node: NodeId) -> LssNodeId {
+        LssNodeId::Node(node)
+    }
+}
+
 /// Error code of a configuration response: success.
 pub const ERROR_NONE: u8 = 0;
 /// Error code of configure node id: the node id is out of range. Of

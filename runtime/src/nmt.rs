@@ -118,31 +118,113 @@ impl fmt::Display for NmtState {
     }
 }
 
+/// The node(s) an NMT command addresses. A broadcast is spelled out
+/// ([`NmtTarget::All`]): an invalid node id never turns into one, since
+/// [`NodeId`] holds only 1 to 127 and [`NmtTarget::try_from`] a `u8`
+/// refuses 0 and 128 to 255.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum NmtTarget {
+    /// Every node: node id 0 on the bus.
+    All,
+    /// One node.
+    Node(NodeId),
+}
+
+impl NmtTarget {
+    /// The node byte of the command frame (0 for [`NmtTarget::All`]).
+    pub const fn to_byte(self) -> u8 {
+        match self {
+            NmtTarget::All => 0,
+            NmtTarget::Node(node) => node.get(),
+        }
+    }
+
+    /// The target a command frame's node byte names: 0 is every node, 1 to
+    /// 127 one node, anything else none (the frame is invalid).
+    pub const fn from_byte(byte: u8) -> Option<NmtTarget> {
+        match byte {
+            0 => Some(NmtTarget::All),
+            n => match NodeId::new(n) {
+                Some(node) => Some(NmtTarget::Node(node)),
+                None => None,
+            },
+        }
+    }
+
+    /// Whether a node with id `node` carries out a command sent to this
+    /// target.
+    pub fn includes(self, node: NodeId) -> bool {
+        match self {
+            NmtTarget::All => true,
+            NmtTarget::Node(target) => target == node,
+        }
+    }
+}
+
+impl From<NodeId> for NmtTarget {
+    fn from(node: NodeId) -> NmtTarget {
+        NmtTarget::Node(node)
+    }
+}
+
+impl TryFrom<u8> for NmtTarget {
+    type Error = InvalidNodeId;
+
+    /// The node `id` (1 to 127). 0 is refused too: a broadcast is
+    /// [`NmtTarget::All`], never a number.
+    fn try_from(id: u8) -> Result<NmtTarget, InvalidNodeId> {
+        NodeId::new(id)
+            .map(NmtTarget::Node)
+            .ok_or(InvalidNodeId(id))
+    }
+}
+
+impl fmt::Display for NmtTarget {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            NmtTarget::All => f.write_str("all nodes"),
+            NmtTarget::Node(node) => write!(f, "node {node}"),
+        }
+    }
+}
+
+/// A node id outside 1 to 127 where one node was meant.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct InvalidNodeId(pub u8);
+
+impl fmt::Display for InvalidNodeId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} is no node id (1 to 127); to address every node use NmtTarget::All",
+            self.0
+        )
+    }
+}
+
+impl core::error::Error for InvalidNodeId {}
+
 /// The NMT frame for `cmd`: COB-ID 0x000, data `[command, node]`, node 0
-/// (`target == None`) addressing all nodes.
-pub const fn command_frame(cmd: NmtCommand, target: Option<NodeId>) -> Frame {
-    let node = match target {
-        Some(node) => node.get(),
-        None => 0,
-    };
-    Frame::standard(cob::NMT, [cmd.to_byte(), node, 0, 0, 0, 0, 0, 0], 2)
+/// for [`NmtTarget::All`].
+pub const fn command_frame(cmd: NmtCommand, target: NmtTarget) -> Frame {
+    Frame::standard(
+        cob::NMT,
+        [cmd.to_byte(), target.to_byte(), 0, 0, 0, 0, 0, 0],
+        2,
+    )
 }
 
 /// Decodes an NMT module-control frame: COB-ID 0x000, a data frame of
-/// exactly 2 bytes, a known command and a node id of 0 (all nodes, `None`)
-/// or 1 to 127. Anything else gives `None`.
-pub fn parse_command(frame: &Frame) -> Option<(NmtCommand, Option<NodeId>)> {
+/// exactly 2 bytes, a known command and a node id of 0 (all nodes) or 1 to
+/// 127. Anything else gives `None`.
+pub fn parse_command(frame: &Frame) -> Option<(NmtCommand, NmtTarget)> {
     if frame.cob_id() != Some(cob::NMT) || frame.is_remote() {
         return None;
     }
     let [cmd, node] = *frame.data() else {
         return None;
     };
-    let cmd = NmtCommand::from_byte(cmd)?;
-    match node {
-        0 => Some((cmd, None)),
-        n => NodeId::new(n).map(|node| (cmd, Some(node))),
-    }
+    Some((NmtCommand::from_byte(cmd)?, NmtTarget::from_byte(node)?))
 }
 
 /// The outbox of [`NmtMaster`] is full; the command was not queued.
@@ -209,22 +291,22 @@ impl NmtMaster {
         }
     }
 
-    /// Queues `cmd` for `target` (`None`: all nodes) and records the state
-    /// the command should bring the node(s) to (see [`NmtMaster::expected`]).
-    /// The reported state ([`NmtMaster::state`]) only changes when a node
-    /// reports. Fails when [`MASTER_OUTBOX`] frames are already queued.
-    pub fn send(&mut self, cmd: NmtCommand, target: Option<NodeId>) -> Result<(), QueueFull> {
+    /// Queues `cmd` for `target` and records the state the command should
+    /// bring the node(s) to (see [`NmtMaster::expected`]). The reported
+    /// state ([`NmtMaster::state`]) only changes when a node reports. Fails
+    /// when [`MASTER_OUTBOX`] frames are already queued.
+    pub fn send(&mut self, cmd: NmtCommand, target: NmtTarget) -> Result<(), QueueFull> {
         self.outbox
             .try_push(command_frame(cmd, target))
             .map_err(|_| QueueFull)?;
         let to = Some(cmd.target_state());
         match target {
-            Some(node) => {
+            NmtTarget::Node(node) => {
                 if let Some(slot) = self.expected.get_mut(usize::from(node.get())) {
                     *slot = to;
                 }
             }
-            None => {
+            NmtTarget::All => {
                 for slot in self.expected.iter_mut().skip(1) {
                     *slot = to;
                 }
@@ -330,16 +412,16 @@ mod tests {
     fn command_frames_match_cia301_layout() {
         // Start node 32: 000#0120.
         assert_eq!(
-            command_frame(NmtCommand::Start, Some(node(32))),
+            command_frame(NmtCommand::Start, NmtTarget::Node(node(32))),
             data(0x000, &[0x01, 0x20])
         );
         // Reset communication of all nodes: 000#8200.
         assert_eq!(
-            command_frame(NmtCommand::ResetCommunication, None),
+            command_frame(NmtCommand::ResetCommunication, NmtTarget::All),
             data(0x000, &[0x82, 0x00])
         );
         assert_eq!(
-            command_frame(NmtCommand::EnterPreOperational, Some(node(127))),
+            command_frame(NmtCommand::EnterPreOperational, NmtTarget::Node(node(127))),
             data(0x000, &[0x80, 0x7F])
         );
     }
@@ -348,11 +430,11 @@ mod tests {
     fn parse_command_accepts_only_valid_frames() {
         assert_eq!(
             parse_command(&data(0x000, &[0x02, 0x05])),
-            Some((NmtCommand::Stop, Some(node(5))))
+            Some((NmtCommand::Stop, NmtTarget::Node(node(5))))
         );
         assert_eq!(
             parse_command(&data(0x000, &[0x81, 0x00])),
-            Some((NmtCommand::ResetNode, None))
+            Some((NmtCommand::ResetNode, NmtTarget::All))
         );
         assert_eq!(parse_command(&data(0x000, &[0x03, 0x05])), None);
         assert_eq!(parse_command(&data(0x000, &[0x01, 0x80])), None);
@@ -366,6 +448,30 @@ mod tests {
         assert_eq!(
             parse_command(&Frame::new(CanId::Extended(0), &[1, 5]).unwrap()),
             None
+        );
+    }
+
+    #[test]
+    fn only_all_addresses_node_zero() {
+        for b in 0..=255u8 {
+            let built = [
+                NmtTarget::try_from(b).ok(),
+                NodeId::new(b).map(NmtTarget::from),
+                NodeId::new(b).map(NmtTarget::Node),
+            ];
+            for target in built.into_iter().flatten() {
+                let frame = command_frame(NmtCommand::ResetNode, target);
+                assert_eq!(frame.data(), [0x81, b]);
+                assert_ne!(target.to_byte(), 0);
+            }
+            assert_eq!(NmtTarget::try_from(b).is_ok(), (1..=127).contains(&b));
+            let parsed = NmtTarget::from_byte(b);
+            assert_eq!(parsed.map(NmtTarget::to_byte), parsed.map(|_| b));
+        }
+        assert_eq!(NmtTarget::try_from(0), Err(InvalidNodeId(0)));
+        assert_eq!(
+            command_frame(NmtCommand::ResetNode, NmtTarget::All).data(),
+            [0x81, 0]
         );
     }
 
@@ -386,12 +492,13 @@ mod tests {
     #[test]
     fn master_queues_commands_without_claiming_state() {
         let mut m = NmtMaster::new();
-        m.send(NmtCommand::Start, Some(node(32))).unwrap();
+        m.send(NmtCommand::Start, NmtTarget::Node(node(32)))
+            .unwrap();
         assert_eq!(m.poll_transmit(), Some(data(0x000, &[0x01, 0x20])));
         assert_eq!(m.poll_transmit(), None);
         assert_eq!(m.state(node(32)), None);
         assert_eq!(m.expected(node(32)), Some(NmtState::Operational));
-        m.send(NmtCommand::Stop, None).unwrap();
+        m.send(NmtCommand::Stop, NmtTarget::All).unwrap();
         assert_eq!(m.expected(node(1)), Some(NmtState::Stopped));
         assert_eq!(m.expected(node(127)), Some(NmtState::Stopped));
         assert!(events(&mut m).is_empty());
@@ -401,9 +508,9 @@ mod tests {
     fn master_outbox_is_bounded() {
         let mut m = NmtMaster::new();
         for _ in 0..MASTER_OUTBOX {
-            m.send(NmtCommand::Start, None).unwrap();
+            m.send(NmtCommand::Start, NmtTarget::All).unwrap();
         }
-        assert_eq!(m.send(NmtCommand::Stop, None), Err(QueueFull));
+        assert_eq!(m.send(NmtCommand::Stop, NmtTarget::All), Err(QueueFull));
         assert_eq!(core::iter::from_fn(|| m.poll_transmit()).count(), 16);
     }
 

@@ -1,7 +1,7 @@
 //! Async drivers over tokio (feature `tokio`): the counterparts of
 //! [`crate::blocking`] for an [`AsyncBus`].
 //!
-//! - [`drive`] and [`serve`] run any [`Service`]; [`SdoClient`] reads and
+//! - [`run`] and [`serve`] run any [`Service`]; [`SdoClient`] reads and
 //!   writes the objects of one node.
 //! - [`Master`] and its [`Driver`]: the composite [`crate::master::Master`]
 //!   with SDO, NMT, PDO configuration and LSS calls, and its events and
@@ -20,8 +20,8 @@ use std::collections::VecDeque;
 use std::string::String;
 use std::vec::Vec;
 
-pub use crate::blocking::{DriveError, Error};
-use crate::blocking::{Transfer, Upload, encode, give_up, transfer_end, visible_string};
+pub use crate::blocking::{Error, RunError};
+use crate::blocking::{Object, Transfer, Upload, encode, give_up, transfer_end, visible_string};
 use crate::od::{self, Entry};
 use crate::sdo::client::{self, ClientConfig, Method};
 use crate::sdo::typed::{self, LengthNote};
@@ -30,7 +30,7 @@ use crate::transport::{AsyncBus, Clock};
 use crate::{Instant, Service};
 
 mod master;
-pub use crate::blocking::Cia402Error;
+mod sdo_stream;
 pub use master::{
     DriveHandle, Driver, Events, LssRequestError, MASTER_QUEUE_CAPACITY, Master,
     PDO_QUEUE_CAPACITY, Pdos,
@@ -47,34 +47,37 @@ pub fn clock() -> Clock {
     Clock::starting_at(::tokio::time::Instant::now().into_std())
 }
 
-/// Runs `service` on `bus` (see [`crate::blocking::drive`]): sends what it
+/// Runs `service` on `bus` (see [`crate::blocking::run`]): sends what it
 /// transmits, feeds it received frames and its timeouts, hands its events
 /// to `until`, and returns what `until` breaks with, or
-/// [`DriveError::Deadline`] once `deadline` passes first. Waits with
+/// [`RunError::Deadline`] once `deadline` passes first. Waits with
 /// `select!` on the bus and `tokio::time::sleep_until`.
 ///
 /// `deadline` is a point in time: an [`Instant`] of the cores (`now(clock)
 /// + Duration::from_millis(50)`), a `tokio::time::Instant` or
 /// [`Deadline::NEVER`] (see [`Deadline`]).
-pub async fn drive<B, S, T>(
+pub async fn run<B, S, T>(
     bus: &mut B,
     clock: &Clock,
     service: &mut S,
-    mut until: impl FnMut(S::Event) -> ControlFlow<T>,
     deadline: impl Into<Deadline>,
-) -> Result<T, DriveError>
+    mut until: impl FnMut(S::Event) -> ControlFlow<T>,
+) -> Result<T, RunError>
 where
     B: AsyncBus + ?Sized,
     S: Service + ?Sized,
 {
     let deadline = deadline.into().on(clock);
-    run(
+    let mut no_hook = |_: &mut S, _| ControlFlow::Continue(());
+    let stop = core::future::pending();
+    run_loop(
         bus,
         clock,
         service,
         &mut until,
         deadline,
-        core::future::pending(),
+        stop,
+        &mut no_hook,
     )
     .await
 }
@@ -102,29 +105,46 @@ where
         ControlFlow::Continue(())
     };
     let deadline = deadline.into().on(clock);
-    match run(bus, clock, service, &mut until, deadline, shutdown).await {
-        Ok(()) | Err(DriveError::Deadline | DriveError::Stopped) => Ok(()),
-        Err(DriveError::Io(e)) => Err(e),
+    let mut no_hook = |_: &mut S, _| ControlFlow::Continue(());
+    match run_loop(
+        bus,
+        clock,
+        service,
+        &mut until,
+        deadline,
+        shutdown,
+        &mut no_hook,
+    )
+    .await
+    {
+        Ok(()) | Err(RunError::Deadline | RunError::Stopped) => Ok(()),
+        Err(RunError::Io(e)) => Err(e),
     }
 }
 
-/// The loop behind [`drive`] and [`serve`], in the cores' time.
-async fn run<B, S, T>(
+/// The loop behind [`run`] and [`serve`], in the cores' time. `hook` runs
+/// first in every round (streamed transfers feed and take data there);
+/// breaking from it stops the loop with [`RunError::Stopped`].
+pub(crate) async fn run_loop<B, S, T>(
     bus: &mut B,
     clock: &Clock,
     service: &mut S,
     until: &mut impl FnMut(S::Event) -> ControlFlow<T>,
     deadline: Option<Instant>,
     shutdown: impl Future<Output = ()>,
-) -> Result<T, DriveError>
+    hook: &mut (dyn FnMut(&mut S, Instant) -> ControlFlow<()> + Send),
+) -> Result<T, RunError>
 where
     B: AsyncBus + ?Sized,
     S: Service + ?Sized,
 {
     let mut shutdown = pin!(shutdown);
     loop {
+        if hook(service, now(clock)).is_break() {
+            return Err(RunError::Stopped);
+        }
         while let Some(frame) = service.poll_transmit() {
-            bus.send(&frame).await.map_err(DriveError::Io)?;
+            bus.send(&frame).await.map_err(RunError::Io)?;
         }
         while let Some(event) = service.poll_event() {
             if let ControlFlow::Break(value) = until(event) {
@@ -133,7 +153,7 @@ where
         }
         let current = now(clock);
         if deadline.is_some_and(|deadline| current >= deadline) {
-            return Err(DriveError::Deadline);
+            return Err(RunError::Deadline);
         }
         let timer = service.poll_timeout();
         if let Some(at) = timer
@@ -154,9 +174,9 @@ where
         // is lost.
         ::tokio::select! {
             biased;
-            () = &mut shutdown => return Err(DriveError::Stopped),
+            () = &mut shutdown => return Err(RunError::Stopped),
             received = bus.recv() => {
-                let frame = received.map_err(DriveError::Io)?;
+                let frame = received.map_err(RunError::Io)?;
                 service.handle_frame(now(clock), &frame);
             }
             () = sleep => {}
@@ -216,6 +236,15 @@ impl<B: AsyncBus> SdoClient<B> {
         self.bus
     }
 
+    /// The object (index, sub) of this client's node.
+    fn object(&self, index: u16, sub: u8) -> Object {
+        Object::new(
+            crate::blocking::channel_node(self.core.config().channel),
+            index,
+            sub,
+        )
+    }
+
     async fn transfer(
         &mut self,
         index: u16,
@@ -223,13 +252,22 @@ impl<B: AsyncBus> SdoClient<B> {
         transfer: Transfer<'_>,
     ) -> Result<Upload, Error> {
         let start = now(&self.clock);
-        transfer.start(&mut self.core, start, index, sub)?;
-        let deadline = start + transfer.bound(self.core.config());
-        let until = |event| transfer_end(event, index, sub);
-        match drive(&mut self.bus, &self.clock, &mut self.core, until, deadline).await {
+        let object = self.object(index, sub);
+        transfer.start(&mut self.core, start, object)?;
+        let limit = transfer.bound(self.core.config());
+        let until = |event| transfer_end(event, object);
+        let result = run(
+            &mut self.bus,
+            &self.clock,
+            &mut self.core,
+            start + limit,
+            until,
+        )
+        .await;
+        match result {
             Ok(result) => result,
             Err(e) => {
-                let error = give_up(&mut self.core, e);
+                let error = give_up(&mut self.core, e, object, Some(limit));
                 while let Some(frame) = self.core.poll_transmit() {
                     // Best effort: the abort frame of a failing bus may not go.
                     let _ = self.bus.send(&frame).await;
@@ -281,16 +319,7 @@ impl<B: AsyncBus> SdoClient<B> {
         E::Access: od::Read,
         E::Value: od::Scalar,
     {
-        let sub = E::SUBINDEX;
-        let upload = self
-            .transfer(E::INDEX, sub, Transfer::Upload(Method::Auto))
-            .await?;
-        let strict = self.core.config().strict_lengths;
-        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)?;
-        if let Some(note) = note {
-            typed::keep(&mut self.notes, note);
-        }
-        Ok(value)
+        self.read_sub::<E>(E::SUBINDEX).await
     }
 
     /// Writes `value` to entry `E`.
@@ -300,8 +329,80 @@ impl<B: AsyncBus> SdoClient<B> {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value)?;
-        self.download(E::INDEX, E::SUBINDEX, buf.get(..len).unwrap_or(&buf))
+        self.write_sub::<E>(E::SUBINDEX, value).await
+    }
+
+    /// Reads element `at` of an ARRAY: the run-time form of
+    /// [`Self::read`] with `A<SUB>`.
+    pub async fn read_at<A>(&mut self, at: od::Element<A>) -> Result<A::Value, Error>
+    where
+        A: od::Array,
+        A::Access: od::Read,
+        A::Value: od::Scalar,
+    {
+        self.read_sub::<A>(at.subindex()).await
+    }
+
+    /// Writes `value` to element `at` of an ARRAY.
+    pub async fn write_at<A>(&mut self, at: od::Element<A>, value: A::Value) -> Result<(), Error>
+    where
+        A: od::Array,
+        A::Access: od::Write,
+        A::Value: od::Scalar,
+    {
+        self.write_sub::<A>(at.subindex(), value).await
+    }
+
+    /// Reads the bytes of element `at` of a byte-valued ARRAY (DOMAIN,
+    /// strings).
+    pub async fn read_bytes_at<A>(&mut self, at: od::Element<A>) -> Result<Vec<u8>, Error>
+    where
+        A: od::Array,
+        A::Access: od::Read,
+        A::Value: od::ByteValue,
+    {
+        self.upload(A::INDEX, at.subindex()).await
+    }
+
+    /// Writes the bytes of element `at` of a byte-valued ARRAY.
+    pub async fn write_bytes_at<A>(&mut self, at: od::Element<A>, data: &[u8]) -> Result<(), Error>
+    where
+        A: od::Array,
+        A::Access: od::Write,
+        A::Value: od::ByteValue,
+    {
+        self.download(A::INDEX, at.subindex(), data).await
+    }
+
+    /// Typed read of sub `sub` of `E`'s object (an entry's own, or an
+    /// array element's).
+    async fn read_sub<E>(&mut self, sub: u8) -> Result<E::Value, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::Scalar,
+    {
+        let upload = self
+            .transfer(E::INDEX, sub, Transfer::Upload(Method::Auto))
+            .await?;
+        let strict = self.core.config().strict_lengths;
+        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)
+            .map_err(|e| self.object(E::INDEX, sub).value(e))?;
+        if let Some(note) = note {
+            typed::keep(&mut self.notes, note);
+        }
+        Ok(value)
+    }
+
+    /// Typed write of sub `sub` of `E`'s object.
+    async fn write_sub<E>(&mut self, sub: u8, value: E::Value) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::Scalar,
+    {
+        let (buf, len) = encode::<E>(value, self.object(E::INDEX, sub))?;
+        self.download(E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
             .await
     }
 
@@ -322,7 +423,8 @@ impl<B: AsyncBus> SdoClient<B> {
         E: Entry<Value = od::bytes::VisibleString>,
         E::Access: od::Read,
     {
-        visible_string(self.upload(E::INDEX, E::SUBINDEX).await?)
+        let data = self.upload(E::INDEX, E::SUBINDEX).await?;
+        visible_string(data, self.object(E::INDEX, E::SUBINDEX))
     }
 
     /// Writes the bytes of a string, DOMAIN or other byte-valued entry.
@@ -337,158 +439,4 @@ impl<B: AsyncBus> SdoClient<B> {
 }
 
 #[cfg(test)]
-mod tests {
-    use core::time::Duration;
-
-    use super::*;
-    use crate::transport::virtual_bus::VirtualBus;
-    use crate::{CanId, Frame};
-
-    /// A test core: reports frames with id 0x200 and a tick every 10 ms.
-    struct Ticker {
-        next: Instant,
-        events: Vec<Result<Frame, Instant>>,
-    }
-
-    impl Service for Ticker {
-        type Event = Result<Frame, Instant>;
-        fn handle_frame(&mut self, _now: Instant, frame: &Frame) {
-            if frame.cob_id() == Some(0x200) {
-                self.events.push(Ok(*frame));
-            }
-        }
-        fn handle_timeout(&mut self, now: Instant) {
-            self.events.push(Err(now));
-            self.next = now + Duration::from_millis(10);
-        }
-        fn poll_transmit(&mut self) -> Option<Frame> {
-            None
-        }
-        fn poll_event(&mut self) -> Option<Self::Event> {
-            (!self.events.is_empty()).then(|| self.events.remove(0))
-        }
-        fn poll_timeout(&self) -> Option<Instant> {
-            Some(self.next)
-        }
-    }
-
-    fn ticker() -> Ticker {
-        Ticker {
-            next: Instant::from_millis(10),
-            events: Vec::new(),
-        }
-    }
-
-    #[::tokio::test(start_paused = true)]
-    async fn drive_runs_timers_until_the_deadline() {
-        let bus = VirtualBus::new();
-        let mut port = bus.attach();
-        let clock = clock();
-        let mut core = ticker();
-        let mut ticks = Vec::new();
-        let start = ::tokio::time::Instant::now();
-        let result = drive(
-            &mut port,
-            &clock,
-            &mut core,
-            |event| {
-                if let Err(at) = event {
-                    ticks.push(at);
-                }
-                ControlFlow::<()>::Continue(())
-            },
-            start + Duration::from_millis(55),
-        )
-        .await;
-        assert!(matches!(result, Err(DriveError::Deadline)));
-        // Paused time: the ticks come exactly on time.
-        let expected: Vec<Instant> = (1..=5).map(|i| Instant::from_millis(10 * i)).collect();
-        assert_eq!(ticks, expected);
-    }
-
-    #[::tokio::test(start_paused = true)]
-    async fn drive_and_serve_take_deadlines_in_the_cores_time() {
-        let bus = VirtualBus::new();
-        let mut port = bus.attach();
-        let clock = clock();
-        let mut core = ticker();
-        let mut ticks = Vec::new();
-        let deadline = now(&clock) + Duration::from_millis(55);
-        let result = drive(
-            &mut port,
-            &clock,
-            &mut core,
-            |event| {
-                if let Err(at) = event {
-                    ticks.push(at);
-                }
-                ControlFlow::<()>::Continue(())
-            },
-            deadline,
-        )
-        .await;
-        assert!(matches!(result, Err(DriveError::Deadline)));
-        // Paused time: the deadline is met exactly, after five ticks.
-        assert_eq!(now(&clock), deadline);
-        assert_eq!(ticks.len(), 5);
-
-        let mut seen = 0;
-        let deadline = now(&clock) + Duration::from_millis(30);
-        serve(
-            &mut port,
-            &clock,
-            &mut core,
-            core::future::pending(),
-            deadline,
-            |_| seen += 1,
-        )
-        .await
-        .unwrap();
-        assert_eq!(now(&clock), deadline);
-        // Ticks at 60, 70 and 80 ms.
-        assert_eq!(seen, 3);
-        // No deadline and a shutdown that has come: returns at once.
-        serve(
-            &mut port,
-            &clock,
-            &mut core,
-            async {},
-            Deadline::NEVER,
-            |_| {},
-        )
-        .await
-        .unwrap();
-        assert_eq!(now(&clock), deadline);
-    }
-
-    #[::tokio::test(start_paused = true)]
-    async fn drive_breaks_on_a_frame_and_serve_stops_on_shutdown() {
-        let bus = VirtualBus::new();
-        let mut port = bus.attach();
-        let peer = bus.attach();
-        let clock = clock();
-        let mut core = ticker();
-        peer.transmit(&Frame::new(CanId::Standard(0x200), &[1]).unwrap());
-        let got = drive(
-            &mut port,
-            &clock,
-            &mut core,
-            |event| match event {
-                Ok(frame) => ControlFlow::Break(frame),
-                Err(_) => ControlFlow::Continue(()),
-            },
-            ::tokio::time::Instant::now() + Duration::from_secs(1),
-        )
-        .await
-        .unwrap();
-        assert_eq!(got.data(), [1]);
-
-        let mut seen = 0;
-        let shutdown = ::tokio::time::sleep(Duration::from_millis(35));
-        serve(&mut port, &clock, &mut core, shutdown, None, |_| seen += 1)
-            .await
-            .unwrap();
-        // Ticks at 10, 20 and 30 ms.
-        assert_eq!(seen, 3);
-    }
-}
+mod tests;

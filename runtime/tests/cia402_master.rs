@@ -10,7 +10,7 @@ use std::thread;
 use std::time::Duration;
 
 use eds2rust_runtime::Frame;
-use eds2rust_runtime::blocking::{self, Cia402Error, Master};
+use eds2rust_runtime::blocking::{self, Error, Master};
 use eds2rust_runtime::cia402::requirements::{Operation, Problem};
 use eds2rust_runtime::cia402::session::StatuswordPdo;
 use eds2rust_runtime::cia402::{
@@ -140,7 +140,7 @@ fn a_fault_that_stays_gives_its_error_code() {
     assert!(
         matches!(
             e,
-            Cia402Error::Operation(OperationError::Fault {
+            Error::Cia402(OperationError::Fault {
                 step: Step::FaultReset,
                 state: State::Fault,
                 code: Some(0x2310)
@@ -220,21 +220,21 @@ fn profile_velocity_waits_for_target_reached() {
     let sim = rig.sim.clone();
     let mut drive = rig.master.drive(node(), &FULL, fast_config()).unwrap();
     // Before enable: refused by the state check, nothing written.
-    let e = drive.velocity(100).unwrap_err();
+    let e = drive.set_velocity(100).unwrap_err();
     assert!(
-        matches!(e, Cia402Error::Operation(OperationError::Refused(_))),
+        matches!(e, Error::Cia402(OperationError::Refused(_))),
         "{e}"
     );
     drive.enable().unwrap();
     let start = drive.master().now();
-    drive.velocity(500).unwrap();
+    drive.set_velocity(500).unwrap();
     assert!(drive.master().now().saturating_duration_since(start) >= SETTLE);
     {
         let sim = sim.lock().unwrap();
         assert_eq!(sim.target_velocity, 500);
         assert_eq!(sim.device.mode(), ModeOfOperation::ProfileVelocity);
     }
-    drive.velocity(0).unwrap();
+    drive.set_velocity(0).unwrap();
     let sw = drive.statusword().unwrap();
     assert!(sw.target_reached() && sw.speed_zero());
     assert_eq!(sim.lock().unwrap().target_velocity, 0);
@@ -301,7 +301,7 @@ fn missing_objects_are_refused_before_any_frame() {
         e.to_string(),
         "profile velocity needs 0x60FF Target velocity, which this device does not have"
     );
-    let Cia402Error::Operation(OperationError::Missing(missing)) = e else {
+    let Error::Cia402(OperationError::Missing(missing)) = e else {
         panic!("{e:?}");
     };
     assert_eq!(missing.operation, Operation::ProfileVelocity);
@@ -313,11 +313,8 @@ fn missing_objects_are_refused_before_any_frame() {
         .master
         .drive(node(), &NO_VELOCITY, SessionConfig::default())
         .unwrap();
-    let e = drive.velocity(10).unwrap_err();
-    assert!(matches!(
-        e,
-        Cia402Error::Operation(OperationError::Missing(_))
-    ));
+    let e = drive.set_velocity(10).unwrap_err();
+    assert!(matches!(e, Error::Cia402(OperationError::Missing(_))));
     assert!(drive.set_profile(1, 2, 3).is_err());
     assert_eq!(drive.session().request(), None);
     drop(drive);
@@ -380,11 +377,11 @@ fn an_sdo_abort_names_the_object() {
     let e = drive.set_profile(1, 2, 3).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "0x6081: the SDO peer aborted the transfer: 0x06020000 (object does not exist in the object dictionary)"
+        "SDO transfer of 0x6081:0 with node 32: the SDO peer aborted the transfer: 0x06020000 (object does not exist in the object dictionary)"
     );
     assert!(matches!(
         e,
-        Cia402Error::Sdo {
+        Error::Sdo {
             index: 0x6081,
             sub: 0,
             ..

@@ -178,7 +178,7 @@ fn fastscan_assigns_every_slave_among_three() {
                     .collect();
                 assert_eq!(states, expected);
                 found.push(identity);
-                let event = bus.run(|m, now| m.configure_node_id(now, node(next_id)));
+                let event = bus.run(|m, now| m.configure_node_id(now, node(next_id).unwrap()));
                 assert_eq!(event, LssEvent::NodeIdConfigured);
                 let event = bus.run(|m, now| m.switch_global(now, LssState::Waiting));
                 assert_eq!(event, LssEvent::Sent);
@@ -250,7 +250,7 @@ fn switch_selective_picks_one_of_three() {
     );
     // The Interroll scenario: the selected drive leaves node 127 for 5.
     assert_eq!(
-        bus.run(|m, now| m.configure_node_id(now, node(5))),
+        bus.run(|m, now| m.configure_node_id(now, node(5).unwrap())),
         LssEvent::NodeIdConfigured
     );
     assert_eq!(bus.run(LssMaster::store_configuration), LssEvent::Stored);
@@ -307,7 +307,7 @@ fn every_service_times_out_without_slaves() {
     type Start = fn(&mut LssMaster, Instant) -> Result<(), LssError>;
     let requests: [Start; 7] = [
         |m, now| m.switch_selective(now, B),
-        |m, now| m.configure_node_id(now, NodeId::new(5)),
+        |m, now| m.configure_node_id(now, NodeId::new(5).unwrap()),
         |m, now| m.configure_bit_timing(now, K250),
         LssMaster::store_configuration,
         |m, now| m.inquire_identity(now, IdentityField::VendorId),

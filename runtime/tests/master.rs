@@ -254,16 +254,17 @@ fn heartbeat_keeps_its_period_during_a_slow_sdo_read() {
     let e = rig.master.upload(node(DEVICE), 0x2001, 0).unwrap_err();
     assert!(matches!(
         e,
-        Error::Sdo(SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist))
+        Error::Sdo {
+            error: SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist),
+            ..
+        }
     ));
 }
 
 #[test]
 fn nmt_command_bytes_and_the_state_the_node_reports() {
     let mut rig = Rig::new();
-    rig.master
-        .nmt(NmtCommand::Start, Some(node(DEVICE)))
-        .unwrap();
+    rig.master.nmt(NmtCommand::Start, node(DEVICE)).unwrap();
     let deadline = StdInstant::now() + Duration::from_secs(1);
     let to = rig
         .master
@@ -417,7 +418,13 @@ fn lss_switch_global_frame() {
     assert_eq!(lss[0].1.to_string(), "7E5#0401000000000000");
     // No LSS slave on this bus: a confirmed request times out.
     let e = rig.master.lss_store().unwrap_err();
-    assert!(matches!(e, blocking::LssRequestError::NoResponse), "{e}");
+    assert!(
+        matches!(
+            e,
+            blocking::Error::Lss(blocking::LssRequestError::NoResponse)
+        ),
+        "{e}"
+    );
 }
 
 #[test]

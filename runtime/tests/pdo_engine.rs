@@ -209,8 +209,9 @@ fn the_device_enforces_the_cia_301_rules() {
     let refused = client.download(0x1A00, 1, &POSITION.to_le_bytes());
     assert_eq!(
         refused.unwrap_err().to_string(),
-        "the SDO peer aborted the transfer: 0x08000022 (data cannot be transferred or stored \
-         to the application because of the present device state)"
+        "SDO transfer of 0x1A00:1 with node 5: the SDO peer aborted the transfer: 0x08000022 \
+         (data cannot be transferred or stored to the application because of the present device \
+         state)"
     );
     stop.store(true, Ordering::Relaxed);
     server.join().unwrap();

@@ -170,14 +170,16 @@ fn blocking_typed_access() {
         client.read_string::<BadName>(),
         Err(Error::NotVisible {
             offset: 2,
-            byte: 0xE9
+            byte: 0xE9,
+            ..
         })
     ));
     assert!(matches!(
         client.download(0x3000, 2, &[1]),
-        Err(Error::Sdo(SdoError::RemoteAbort(
-            AbortCode::ObjectDoesNotExist
-        )))
+        Err(Error::Sdo {
+            error: SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist),
+            ..
+        })
     ));
 
     stop.store(true, Ordering::Relaxed);
@@ -200,10 +202,13 @@ fn blocking_strict_lengths_refuse_a_longer_value() {
     let mut client = blocking::SdoClient::new(bus.attach(), strict);
     assert!(matches!(
         client.read::<Counter>(),
-        Err(Error::Value(ValueError::Length {
-            expected: 2,
-            actual: 4
-        }))
+        Err(Error::Value {
+            error: ValueError::Length {
+                expected: 2,
+                actual: 4
+            },
+            ..
+        })
     ));
     // Padding of a response without size is no excess.
     assert_eq!(client.read::<Mode>().unwrap(), -3);
@@ -220,7 +225,10 @@ fn blocking_silent_node_times_out_with_an_abort() {
     let start = std::time::Instant::now();
     assert!(matches!(
         client.read::<Silent>(),
-        Err(Error::Sdo(SdoError::Timeout))
+        Err(Error::Sdo {
+            error: SdoError::Timeout,
+            ..
+        })
     ));
     let took = start.elapsed();
     assert!(
@@ -287,9 +295,10 @@ mod tokio_drivers {
         assert!(client.take_length_notes().is_empty());
         assert!(matches!(
             client.upload(0x3000, 1).await,
-            Err(Error::Sdo(SdoError::RemoteAbort(
-                AbortCode::ObjectDoesNotExist
-            )))
+            Err(Error::Sdo {
+                error: SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist),
+                ..
+            })
         ));
         AsyncBus::send(client.bus_mut(), &stop_frame())
             .await
@@ -306,7 +315,10 @@ mod tokio_drivers {
         let start = ::tokio::time::Instant::now();
         assert!(matches!(
             client.read::<Silent>().await,
-            Err(Error::Sdo(SdoError::Timeout))
+            Err(Error::Sdo {
+                error: SdoError::Timeout,
+                ..
+            })
         ));
         let took = start.elapsed();
         assert!(

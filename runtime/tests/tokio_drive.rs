@@ -193,7 +193,7 @@ async fn a_missing_object_is_refused_before_any_frame() {
     let mut drive = rig.master.drive(node(), &NO_VELOCITY, config()).unwrap();
     tokio::time::sleep(Duration::from_millis(10)).await;
     rig.frames();
-    let e = drive.velocity(100).await.unwrap_err();
+    let e = drive.set_velocity(100).await.unwrap_err();
     assert_eq!(
         e.to_string(),
         "profile velocity needs 0x60FF Target velocity, which this device does not have"

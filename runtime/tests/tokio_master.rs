@@ -12,7 +12,7 @@ use std::time::Duration;
 use eds2rust_runtime::Frame;
 use eds2rust_runtime::blocking::Error;
 use eds2rust_runtime::master;
-use eds2rust_runtime::nmt::NmtCommand;
+use eds2rust_runtime::nmt::{NmtCommand, NmtTarget};
 use eds2rust_runtime::od::{self, PdoDirection};
 use eds2rust_runtime::pdo::{PdoConfig, StepAction};
 use eds2rust_runtime::sdo::client::Method;
@@ -51,9 +51,10 @@ async fn typed_segmented_and_block_transfers() {
     // A missing object: the device's abort comes back.
     assert!(matches!(
         m.upload(dev, 0x2001, 0).await,
-        Err(Error::Sdo(SdoError::RemoteAbort(
-            AbortCode::ObjectDoesNotExist
-        )))
+        Err(Error::Sdo {
+            error: SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist),
+            ..
+        })
     ));
     // The expedited write of 0x1017 on the wire (CiA 301: 0x2B, 2 bytes).
     let writes: Vec<Frame> = rig
@@ -132,7 +133,16 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
     let start = TokioInstant::now();
     // No node 0x32 on the bus.
     let e = rig.master.upload(node(0x32), 0x1000, 0).await.unwrap_err();
-    assert!(matches!(e, Error::Sdo(SdoError::Timeout)), "{e}");
+    assert!(
+        matches!(
+            e,
+            Error::Sdo {
+                error: SdoError::Timeout,
+                ..
+            }
+        ),
+        "{e}"
+    );
     assert_eq!(start.elapsed(), Duration::from_millis(200));
     let aborts: Vec<String> = rig
         .seen()
@@ -143,7 +153,16 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
     assert_eq!(aborts, ["632#4000100000000000", "632#8000100000000405"]);
     // A later call works (and times out the same way).
     let e = rig.master.upload(node(0x32), 0x1000, 0).await.unwrap_err();
-    assert!(matches!(e, Error::Sdo(SdoError::Timeout)), "{e}");
+    assert!(
+        matches!(
+            e,
+            Error::Sdo {
+                error: SdoError::Timeout,
+                ..
+            }
+        ),
+        "{e}"
+    );
     rig.seen();
     // A future dropped in place (a `timeout` around it) is aborted at once.
     let start = TokioInstant::now();
@@ -228,6 +247,9 @@ async fn configure_pdo_writes_in_the_cia_301_order_and_reads_back() {
         .configure_pdo(node(DEVICE), &refused)
         .await
         .unwrap_err();
+    let Error::PdoConfig(e) = e else {
+        panic!("{e:?}")
+    };
     assert_eq!(e.abort_code(), Some(AbortCode::ObjectDoesNotExist));
     assert_eq!(e.step().map(|s| (s.index(), s.sub())), Some((0x1801, 1)));
 }
@@ -263,9 +285,13 @@ async fn the_driver_ends_with_the_last_handle_and_calls_fail_after_it_stopped() 
     drop(driver);
     assert!(!master.is_running());
     let e = master.upload(node(DEVICE), 0x1000, 0).await.unwrap_err();
-    assert!(matches!(e, Error::Io(_)), "{e}");
+    assert!(matches!(e, Error::DriverStopped { .. }), "{e}");
+    assert!(e.to_string().contains("the driver was dropped"), "{e}");
     assert!(master.start().await.is_err());
-    assert!(master.nmt(NmtCommand::Start, None).await.is_err());
+    assert!(matches!(
+        master.nmt(NmtCommand::Start, NmtTarget::All).await,
+        Err(Error::DriverStopped { .. })
+    ));
 }
 
 #[test]
@@ -282,7 +308,7 @@ fn futures_are_send() {
     assert_send(&m.read::<ProducerHeartbeatTime>(node(DEVICE)));
     assert_send(&m.upload(node(DEVICE), 0x1000, 0));
     assert_send(&m.lss_inquire_node_id());
-    assert_send(&m.nmt(NmtCommand::Start, None));
+    assert_send(&m.nmt(NmtCommand::Start, NmtTarget::All));
     let config =
         PdoConfig::new(PdoDirection::Tpdo, 1, 0x1A0, <Counter as od::Pdo>::MAPPING).unwrap();
     assert_send(&m.configure_pdo(node(DEVICE), &config));

@@ -14,7 +14,7 @@ use eds2rust_runtime::emcy::EmcyEvent;
 use eds2rust_runtime::heartbeat::HeartbeatEvent;
 use eds2rust_runtime::lss::{IdentityField, LssState};
 use eds2rust_runtime::master::MasterEvent;
-use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState};
+use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState, NmtTarget};
 use eds2rust_runtime::od::PdoLengthError;
 use eds2rust_runtime::sync::SyncProducer;
 use tokio::time::Instant as TokioInstant;
@@ -51,7 +51,7 @@ async fn heartbeat_timeout_comes_at_the_right_virtual_time() {
 async fn emcy_and_nmt_events_and_command_frames() {
     let mut rig = Rig::new(|_| {}).await;
     rig.master
-        .nmt(NmtCommand::Start, Some(node(DEVICE)))
+        .nmt(NmtCommand::Start, node(DEVICE))
         .await
         .unwrap();
     let to = rig
@@ -65,7 +65,10 @@ async fn emcy_and_nmt_events_and_command_frames() {
         })
         .await;
     assert_eq!(to, NmtState::Operational);
-    rig.master.nmt(NmtCommand::ResetNode, None).await.unwrap();
+    rig.master
+        .nmt(NmtCommand::ResetNode, NmtTarget::All)
+        .await
+        .unwrap();
     tokio::time::sleep(Duration::from_millis(1)).await;
     let nmt: Vec<String> = rig
         .seen()
@@ -172,7 +175,12 @@ async fn lss_switch_and_inquire() {
     // In the waiting state the slave does not answer: the core's timeout.
     let e = m.lss_inquire_node_id().await.unwrap_err();
     assert!(
-        matches!(e, eds2rust_runtime::tokio::LssRequestError::NoResponse),
+        matches!(
+            e,
+            eds2rust_runtime::tokio::Error::Lss(
+                eds2rust_runtime::tokio::LssRequestError::NoResponse
+            )
+        ),
         "{e}"
     );
     let lss: Vec<String> = rig

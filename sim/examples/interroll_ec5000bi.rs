@@ -158,7 +158,7 @@ fn assign_node_id(m: &mut M, address: Identity, out: &mut dyn Write) -> Res<Node
     writeln!(out, "LSS: selecting the drive with serial number {serial}")?;
     m.lss_switch_selective(address)
         .map_err(|e| format!("LSS switch state selective (serial {serial}): {e}"))?;
-    m.lss_configure_node_id(Some(new))
+    m.lss_configure_node_id(new)
         .map_err(|e| format!("LSS configure node id {NEW_NODE}: {e}"))?;
     writeln!(out, "LSS: node id {NEW_NODE} configured")?;
     m.lss_store()
@@ -166,7 +166,7 @@ fn assign_node_id(m: &mut M, address: Identity, out: &mut dyn Write) -> Res<Node
     writeln!(out, "LSS: configuration stored (survives a power cycle)")?;
     m.lss_switch_global(LssState::Waiting)
         .map_err(|e| format!("LSS switch state global (waiting): {e}"))?;
-    m.nmt(NmtCommand::ResetCommunication, Some(node(DEFAULT_NODE_ID)?))?;
+    m.nmt(NmtCommand::ResetCommunication, node(DEFAULT_NODE_ID)?)?;
     let deadline = std::time::Instant::now() + WAIT;
     m.run_until(deadline, |e| match e {
         MasterEvent::Nmt(NmtEvent::BootUp(n)) if *n == new => ControlFlow::Break(()),
@@ -273,7 +273,7 @@ fn scenario(m: &mut M, args: &Args, out: &mut dyn Write) -> Res<Summary> {
         .map_err(|e| format!("node {NEW_NODE}: reading 0x1008: {e}"))?;
     let sn = read::<od::identity::SerialNumber>(m, n)?;
     writeln!(out, "node {NEW_NODE}: {name}, serial number {sn}")?;
-    m.nmt(NmtCommand::Start, Some(n))?;
+    m.nmt(NmtCommand::Start, n)?;
 
     writeln!(out, "CiA 402: profile velocity mode (0x6060 = 3)")?;
     write::<od::ModesOfOperation>(m, n, od::ModesOfOperationValue::PROFILE_VELOCITY)?;

@@ -29,7 +29,7 @@ use eds2rust_drivers::linak_techline::od::consumer_heartbeat_time::{
 };
 use eds2rust_drivers::linak_techline::od::{command, feedback};
 use eds2rust_drivers::linak_techline::pdo::{Rpdo1Command, Tpdo1Feedback};
-use eds2rust_runtime::blocking::{self, DriveError};
+use eds2rust_runtime::blocking;
 use eds2rust_runtime::emcy::EmcyEvent;
 use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState};
@@ -131,7 +131,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<Summary> {
     )?;
     // Only the boot-up after the reset counts.
     m.drain_events();
-    m.nmt(NmtCommand::ResetNode, Some(NODE))?;
+    m.nmt(NmtCommand::ResetNode, NODE)?;
     wait_boot_up(&mut m)?;
     writeln!(
         out,
@@ -147,7 +147,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<Summary> {
         out,
         "node {NODE}: consumes the heartbeat of node {MASTER_NODE}, {CONSUMER_TIME_MS} ms (0x1016 sub 1)"
     )?;
-    m.nmt(NmtCommand::Start, Some(NODE))?;
+    m.nmt(NmtCommand::Start, NODE)?;
     let first = next_feedback(&mut m, ANSWER_TIMEOUT, "after NMT start")?;
     report(out, "operational", &first)?;
 
@@ -193,7 +193,7 @@ fn wait_boot_up(m: &mut Master) -> Result<()> {
         _ => ControlFlow::Continue(()),
     })
     .map_err(|e| {
-        drive_error(
+        wait_error(
             e,
             &format!(
                 "node {NODE}: no boot-up message within {ANSWER_TIMEOUT:?} after NMT reset node"
@@ -245,7 +245,7 @@ fn next_feedback(m: &mut Master, timeout: Duration, what: &str) -> Result<Tpdo1F
             _ => ControlFlow::Continue(()),
         })
         .map_err(|e| {
-            drive_error(
+            wait_error(
                 e,
                 &format!("node {NODE}: no TPDO1 (0x{cob:03X}) {what} within {timeout:?}"),
             )
@@ -290,10 +290,10 @@ fn wait_feedback(
     }
 }
 
-fn drive_error(e: DriveError, what: &str) -> Box<dyn Error> {
+fn wait_error(e: blocking::Error, what: &str) -> Box<dyn Error> {
     match e {
-        DriveError::Io(e) => Box::new(e),
-        DriveError::Deadline | DriveError::Stopped => Box::new(ScenarioError(what.to_string())),
+        blocking::Error::DeadlinePassed => Box::new(ScenarioError(what.to_string())),
+        e => Box::new(e),
     }
 }
 

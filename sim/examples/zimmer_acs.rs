@@ -149,7 +149,7 @@ impl Session<'_> {
         // The first statusword by SDO: the node is there (booted).
         self.read_status()?;
         // 15.3: PDOs only in Operational.
-        self.master.nmt(NmtCommand::Start, Some(NODE))?;
+        self.master.nmt(NmtCommand::Start, NODE)?;
         writeln!(self.out, "node {NODE}: NMT start")?;
 
         writeln!(
@@ -305,7 +305,10 @@ impl Session<'_> {
             if self.drive.poll_timeout().is_some_and(|at| at <= now) {
                 self.drive.handle_timeout(now);
             }
-            match self.master.wait_event(Duration::from_millis(10))? {
+            match self
+                .master
+                .wait_event(self.master.now() + Duration::from_millis(10))?
+            {
                 Some(MasterEvent::Pdo(PdoEvent::Received {
                     cob_id, data, len, ..
                 })) if cob_id == self.tpdo1 => {

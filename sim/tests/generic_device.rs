@@ -9,7 +9,7 @@ use std::time::Duration;
 use eds2rust_drivers::{example, zimmer_acs};
 use eds2rust_runtime::lss::{BitRate, Identity, LssState};
 use eds2rust_runtime::master::{Master, MasterEvent};
-use eds2rust_runtime::nmt::{NmtCommand, NmtState};
+use eds2rust_runtime::nmt::{NmtCommand, NmtState, NmtTarget};
 use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::sdo::SdoError;
 use eds2rust_runtime::sdo::abort::AbortCode;
@@ -172,7 +172,7 @@ fn pdo_mapping_follows_the_cia_301_order_and_rules() {
     // event timer: position (0), statusword (0).
     b.master
         .nmt
-        .send(NmtCommand::Start, Some(n))
+        .send(NmtCommand::Start, NmtTarget::Node(n))
         .expect("queue");
     b.run_for(Duration::from_millis(150));
     let tpdos: Vec<String> = b
@@ -188,7 +188,7 @@ fn rpdos_write_the_mapped_entries_and_length_errors_raise_emcy() {
     let mut b = example_bench();
     b.master
         .nmt
-        .send(NmtCommand::Start, Some(node(5)))
+        .send(NmtCommand::Start, NmtTarget::Node(node(5)))
         .expect("queue");
     b.run_for(Duration::from_millis(1));
     // RPDO1: controlword 0x000F, target position 1000.
@@ -224,7 +224,7 @@ fn rpdos_write_the_mapped_entries_and_length_errors_raise_emcy() {
     // Pre-operational: RPDOs are ignored.
     b.master
         .nmt
-        .send(NmtCommand::EnterPreOperational, Some(node(5)))
+        .send(NmtCommand::EnterPreOperational, NmtTarget::Node(node(5)))
         .expect("queue");
     b.run_for(Duration::from_millis(1));
     b.inject(&frame(0x205, &[0x07, 0x00, 0, 0, 0, 0]));
@@ -291,10 +291,7 @@ fn an_unconfigured_lss_slave_gets_its_node_id_and_moves_its_sdo_server() {
         .expect("idle");
     b.run_for(Duration::from_millis(1));
     let now = b.now();
-    b.master
-        .lss
-        .configure_node_id(now, Some(node(9)))
-        .expect("idle");
+    b.master.lss.configure_node_id(now, node(9)).expect("idle");
     assert!(b.run_until(Duration::from_millis(200), |e| matches!(
         e,
         MasterEvent::Lss(_)

@@ -7,7 +7,7 @@ use std::time::Duration;
 
 use eds2rust_runtime::lss::LssState;
 use eds2rust_runtime::master::{Master, MasterEvent};
-use eds2rust_runtime::nmt::NmtCommand;
+use eds2rust_runtime::nmt::{NmtCommand, NmtTarget};
 use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::sdo::SdoError;
 use eds2rust_runtime::sdo::abort::AbortCode;
@@ -135,7 +135,7 @@ fn assign_node_5(b: &mut Bench<Ec5000Bi>, store: bool) {
     let now = b.now();
     b.master
         .lss
-        .configure_node_id(now, Some(node(5)))
+        .configure_node_id(now, node(5))
         .expect("lss idle");
     lss_wait(b);
     if store {
@@ -151,7 +151,7 @@ fn assign_node_5(b: &mut Bench<Ec5000Bi>, store: bool) {
     lss_wait(b);
     b.master
         .nmt
-        .send(NmtCommand::ResetCommunication, Some(node(N127)))
+        .send(NmtCommand::ResetCommunication, NmtTarget::Node(node(N127)))
         .expect("nmt queue");
     b.run_for(Duration::from_millis(20));
 }
@@ -428,7 +428,7 @@ fn tpdos_follow_chapter_8() {
     b.trace.clear();
     b.master
         .nmt
-        .send(NmtCommand::Start, Some(node(N127)))
+        .send(NmtCommand::Start, NmtTarget::Node(node(N127)))
         .expect("nmt queue");
     b.run_for(Duration::from_millis(5));
     // TPDO1: statusword, mode display, error register, 25 °C, torque 0.

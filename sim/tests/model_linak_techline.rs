@@ -9,7 +9,7 @@ use std::time::Duration;
 
 use eds2rust_drivers::linak_techline::errors::LinakErrors;
 use eds2rust_runtime::master::Master;
-use eds2rust_runtime::nmt::{NmtCommand, NmtState};
+use eds2rust_runtime::nmt::{NmtCommand, NmtState, NmtTarget};
 use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::sdo::SdoError;
 use eds2rust_runtime::sdo::abort::AbortCode;
@@ -60,7 +60,10 @@ fn started(model: LinakTechline) -> B {
 }
 
 fn nmt(b: &mut B, cmd: NmtCommand) {
-    b.master.nmt.send(cmd, Some(NODE)).expect("nmt queue");
+    b.master
+        .nmt
+        .send(cmd, NmtTarget::Node(NODE))
+        .expect("nmt queue");
     b.run_for(ms(1));
 }
 

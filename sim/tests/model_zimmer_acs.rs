@@ -10,7 +10,7 @@ use std::time::Duration;
 use eds2rust_drivers::zimmer_acs::errors::ZimmerErrors;
 use eds2rust_runtime::cia402::State;
 use eds2rust_runtime::master::Master;
-use eds2rust_runtime::nmt::NmtCommand;
+use eds2rust_runtime::nmt::{NmtCommand, NmtTarget};
 use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::sdo::SdoError;
 use eds2rust_runtime::sdo::abort::AbortCode;
@@ -64,7 +64,7 @@ fn controlword(b: &mut Bench<ZimmerAcs>, cw: u16) {
 fn start_node(b: &mut Bench<ZimmerAcs>) {
     b.master
         .nmt
-        .send(NmtCommand::Start, Some(NODE))
+        .send(NmtCommand::Start, NmtTarget::Node(NODE))
         .expect("queue");
     b.run_for(ms(1));
 }

@@ -26,11 +26,11 @@ use serde_json::Value;
 
 use crate::python::{python, scripts_dir};
 
-mod drive;
 mod reply;
+mod step;
 
-pub use drive::{flush, run_until, step};
 pub use reply::{Outcome, hex, unhex};
+pub use step::{flush, run_until, step};
 
 /// How long [`PyPeer::command`] waits for a reply.
 pub const COMMAND_TIMEOUT: Duration = Duration::from_secs(10);

@@ -14,7 +14,7 @@ use eds2rust_drivers::linak_techline::od::{ProducerHeartbeatTime, ProducerHeartb
 use eds2rust_runtime::blocking::SdoClient;
 use eds2rust_runtime::heartbeat::{HeartbeatConsumer, HeartbeatEvent, HeartbeatProducer};
 use eds2rust_runtime::nmt::{
-    NmtCommand, NmtEvent, NmtMaster, NmtSlave, NmtSlaveEvent, NmtState, parse_command,
+    NmtCommand, NmtEvent, NmtMaster, NmtSlave, NmtSlaveEvent, NmtState, NmtTarget, parse_command,
 };
 use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::sdo::Channel;
@@ -123,8 +123,8 @@ fn our_nmt_master_commands_python_node() {
         } else {
             NmtCommand::Stop
         };
-        master.send(other, Some(node(ID + 1))).unwrap();
-        master.send(cmd, Some(n)).unwrap();
+        master.send(other, NmtTarget::Node(node(ID + 1))).unwrap();
+        master.send(cmd, NmtTarget::Node(n)).unwrap();
         send_all(&mut port, &mut master);
         assert_eq!(python_state(py, ID), code, "after {cmd}");
         // python's heartbeat reports the new state to our master.
@@ -145,7 +145,7 @@ fn our_nmt_master_commands_python_node() {
             py,
             json!({"op": "local_nmt", "node": ID, "state": "OPERATIONAL"}),
         );
-        master.send(cmd, Some(n)).unwrap();
+        master.send(cmd, NmtTarget::Node(n)).unwrap();
         send_all(&mut port, &mut master);
         assert_eq!(python_state(py, ID), 0, "after {cmd}");
     }
@@ -166,7 +166,7 @@ fn our_nmt_broadcast_reaches_every_python_node() {
         (NmtCommand::Stop, 4),
         (NmtCommand::EnterPreOperational, 127),
     ] {
-        master.send(cmd, None).unwrap();
+        master.send(cmd, NmtTarget::All).unwrap();
         send_all(&mut port, &mut master);
         for id in [1, 2, 0x7F] {
             assert_eq!(
@@ -222,7 +222,10 @@ fn python_nmt_commands_parse_with_our_slave() {
         let frames = run(ID, command, &mut slave);
         assert_eq!(frames.len(), 1, "{frames:?}");
         assert_eq!(frames[0].data(), &[command, ID]);
-        assert_eq!(parse_command(&frames[0]), Some((cmd, Some(node(ID)))));
+        assert_eq!(
+            parse_command(&frames[0]),
+            Some((cmd, NmtTarget::Node(node(ID))))
+        );
         assert_eq!(
             events(&mut slave),
             vec![NmtSlaveEvent::StateChanged { from, to }]
@@ -233,7 +236,7 @@ fn python_nmt_commands_parse_with_our_slave() {
     let frames = run(0x3F, 0x01, &mut slave);
     assert_eq!(
         parse_command(&frames[0]),
-        Some((NmtCommand::Start, Some(node(0x3F))))
+        Some((NmtCommand::Start, NmtTarget::Node(node(0x3F))))
     );
     assert_eq!(events(&mut slave), vec![]);
 
@@ -247,7 +250,10 @@ fn python_nmt_commands_parse_with_our_slave() {
 
     // Broadcast from python's network NMT master (node 0).
     let frames = run(0, 0x01, &mut slave);
-    assert_eq!(parse_command(&frames[0]), Some((NmtCommand::Start, None)));
+    assert_eq!(
+        parse_command(&frames[0]),
+        Some((NmtCommand::Start, NmtTarget::All))
+    );
     assert_eq!(
         events(&mut slave),
         vec![NmtSlaveEvent::StateChanged {
@@ -260,7 +266,7 @@ fn python_nmt_commands_parse_with_our_slave() {
     let frames = run(ID, 0x82, &mut slave);
     assert_eq!(
         parse_command(&frames[0]),
-        Some((NmtCommand::ResetCommunication, Some(node(ID))))
+        Some((NmtCommand::ResetCommunication, NmtTarget::Node(node(ID))))
     );
     assert_eq!(
         events(&mut slave),
@@ -277,7 +283,7 @@ fn python_nmt_commands_parse_with_our_slave() {
     let frames = run(ID, 0x81, &mut slave);
     assert_eq!(
         parse_command(&frames[0]),
-        Some((NmtCommand::ResetNode, Some(node(ID))))
+        Some((NmtCommand::ResetNode, NmtTarget::Node(node(ID))))
     );
     assert_eq!(
         events(&mut slave),

@@ -86,7 +86,7 @@ fn our_client(id: u8) -> SdoClient<PeerPort> {
 /// The SDO error of a failed transfer (any other failure is a test failure).
 fn sdo_error<T: std::fmt::Debug>(result: Result<T, blocking::Error>) -> Result<T, SdoError> {
     result.map_err(|e| match e {
-        blocking::Error::Sdo(e) => e,
+        blocking::Error::Sdo { error: e, .. } => e,
         other => panic!("{}", py().failure(&format!("not an SDO error: {other}"))),
     })
 }

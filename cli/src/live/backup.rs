@@ -114,7 +114,13 @@ pub fn upload(
                 data
             }
             Err(e) => {
-                let timeout = matches!(e, blocking::Error::Sdo(SdoError::Timeout));
+                let timeout = matches!(
+                    e,
+                    blocking::Error::Sdo {
+                        error: SdoError::Timeout,
+                        ..
+                    }
+                );
                 timeouts_in_a_row = if timeout { timeouts_in_a_row + 1 } else { 0 };
                 let err = transfer_error(node, &label, "read", &e, a.bus.timeout);
                 // A node that does not answer at all, or no longer: no DCF.
@@ -461,7 +467,10 @@ fn run_steps(
     let stop = |e: &blocking::Error| {
         matches!(
             e,
-            blocking::Error::Sdo(SdoError::Timeout) | blocking::Error::Io(_)
+            blocking::Error::Sdo {
+                error: SdoError::Timeout,
+                ..
+            } | blocking::Error::Io(_)
         )
     };
     for (i, step) in plan.steps.iter().enumerate() {
@@ -523,7 +532,7 @@ fn run_steps(
                     if *check {
                         tally.refused += 1;
                         let code = match &e {
-                            blocking::Error::Sdo(s) => s.code().to_string(),
+                            blocking::Error::Sdo { error: s, .. } => s.code().to_string(),
                             other => other.to_string(),
                         };
                         lines.push(format!("{label}: refused {shown}: {code}"));

@@ -5,10 +5,10 @@ use std::ops::ControlFlow;
 use std::time::Duration;
 
 use clap::{ArgGroup, Args};
-use eds2rust_runtime::blocking::{DriveError, LssRequestError, Master};
+use eds2rust_runtime::blocking::{Error, LssRequestError, Master};
 use eds2rust_runtime::lss::{Identity, KnownIdentity, LssState};
 use eds2rust_runtime::master::MasterEvent;
-use eds2rust_runtime::nmt::{NmtCommand, NmtEvent};
+use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtTarget};
 use eds2rust_runtime::od::NodeId;
 
 use super::bus::{self, LiveBus};
@@ -80,7 +80,7 @@ pub fn parse_identity(text: &str) -> Result<Identity, String> {
     }
 }
 
-fn lss_failed(what: &str, e: LssRequestError) -> LiveError {
+fn lss_failed(what: &str, e: Error) -> LiveError {
     LiveError::Failed(format!("LSS {what}: {e}"))
 }
 
@@ -114,7 +114,7 @@ pub fn scan(
             let node = u8::try_from(n).ok().and_then(NodeId::new).ok_or_else(|| {
                 LiveError::Failed(format!("--assign {first}: node id {n} is past 127"))
             })?;
-            m.lss_configure_node_id(Some(node))
+            m.lss_configure_node_id(node)
                 .map_err(|e| lss_failed("configure node id", e))?;
             if a.store {
                 m.lss_store()
@@ -171,7 +171,7 @@ pub fn set_node_id(
     m.core_mut().lss.set_timeout(a.lss_timeout);
     if let Some(identity) = a.identity {
         m.lss_switch_selective(identity).map_err(|e| match e {
-            LssRequestError::NoResponse => LiveError::Failed(format!(
+            Error::Lss(LssRequestError::NoResponse) => LiveError::Failed(format!(
                 "no LSS slave with the address {} answered",
                 row(&identity)
                     .split_whitespace()
@@ -201,7 +201,7 @@ pub fn set_node_id(
         writeln!(out, "switched every LSS slave to the configuration state")?;
     }
     let configured = m
-        .lss_configure_node_id(Some(node))
+        .lss_configure_node_id(node)
         .map_err(|e| lss_failed("configure node id", e));
     if let Err(e) = configured {
         let _ = m.lss_switch_global(LssState::Waiting);
@@ -220,7 +220,7 @@ pub fn set_node_id(
     if !a.activate {
         writeln!(
             out,
-            "the node id takes effect at the next NMT reset communication (eds2rust nmt reset-comm)"
+            "the node id takes effect at the next NMT reset communication (eds2rust nmt reset-comm --all)"
         )?;
         return Ok(());
     }
@@ -229,8 +229,8 @@ pub fn set_node_id(
 
 /// NMT reset communication to all nodes; waits for `node`'s boot-up.
 fn activate(m: &mut Master<LiveBus>, node: NodeId, out: &mut dyn Write) -> Result<(), LiveError> {
-    m.nmt(NmtCommand::ResetCommunication, None)
-        .map_err(|e| LiveError::Failed(format!("CAN bus error: {e}")))?;
+    m.nmt(NmtCommand::ResetCommunication, NmtTarget::All)
+        .map_err(|e| LiveError::Failed(e.to_string()))?;
     writeln!(out, "sent NMT reset communication to all nodes")?;
     let deadline = m.now() + BOOT_WAIT;
     match m.run_until(deadline, |event| match event {
@@ -241,11 +241,11 @@ fn activate(m: &mut Master<LiveBus>, node: NodeId, out: &mut dyn Write) -> Resul
             writeln!(out, "node {}: boot-up seen", node.get())?;
             Ok(())
         }
-        Err(DriveError::Io(e)) => Err(LiveError::Failed(format!("CAN bus error: {e}"))),
-        Err(_) => Err(LiveError::Failed(format!(
+        Err(Error::DeadlinePassed) => Err(LiveError::Failed(format!(
             "no boot-up message from node {} within {} s",
             node.get(),
             BOOT_WAIT.as_secs()
         ))),
+        Err(e) => Err(LiveError::Failed(e.to_string())),
     }
 }

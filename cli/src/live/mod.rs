@@ -166,9 +166,12 @@ pub struct NmtArgs {
     pub verb: NmtVerb,
     #[command(flatten)]
     pub bus: BusArgs,
-    /// The node (all nodes when absent).
-    #[arg(long, short = 'n', value_parser = node_arg)]
+    /// The node.
+    #[arg(long, short = 'n', value_parser = node_arg, required_unless_present = "all")]
     pub node: Option<u8>,
+    /// Every node (NMT broadcast, node id 0); instead of --node.
+    #[arg(long, conflicts_with = "node")]
+    pub all: bool,
     /// Wait (up to 2 s) for the node's boot-up (resets) or a heartbeat in
     /// the new state; exit status 1 when none comes.
     #[arg(long, requires = "node")]

@@ -5,9 +5,9 @@ use std::io::Write;
 use std::ops::ControlFlow;
 use std::time::Duration;
 
-use eds2rust_runtime::blocking::{DriveError, Master};
+use eds2rust_runtime::blocking::{Error, Master};
 use eds2rust_runtime::master::MasterEvent;
-use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState};
+use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState, NmtTarget};
 use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::sdo::SdoError;
 use eds2rust_runtime::sdo::client::ClientEvent;
@@ -34,8 +34,8 @@ pub fn state_name(state: NmtState) -> &'static str {
     }
 }
 
-fn io_failed(e: std::io::Error) -> LiveError {
-    LiveError::Failed(format!("CAN bus error: {e}"))
+fn io_failed(e: Error) -> LiveError {
+    LiveError::Failed(e.to_string())
 }
 
 pub fn command(
@@ -50,13 +50,27 @@ pub fn command(
         NmtVerb::Reset => (NmtCommand::ResetNode, "reset node"),
         NmtVerb::ResetComm => (NmtCommand::ResetCommunication, "reset communication"),
     };
-    let target = a.node.map(bus::node_id).transpose()?;
+    let target = match (a.node, a.all) {
+        (Some(n), false) => NmtTarget::Node(bus::node_id(n)?),
+        (None, true) => NmtTarget::All,
+        _ => {
+            return Err(LiveError::Usage(
+                "name the node with --node, or every node with --all".to_string(),
+            ));
+        }
+    };
     let mut m = bus::master(open()?);
     m.nmt(cmd, target).map_err(io_failed)?;
-    match target {
-        Some(node) => writeln!(out, "sent NMT {name} to node {}", node.get())?,
-        None => writeln!(out, "sent NMT {name} to all nodes")?,
-    }
+    let target = match target {
+        NmtTarget::Node(node) => {
+            writeln!(out, "sent NMT {name} to node {}", node.get())?;
+            Some(node)
+        }
+        NmtTarget::All => {
+            writeln!(out, "sent NMT {name} to all nodes")?;
+            None
+        }
+    };
     let Some(node) = target.filter(|_| a.confirm) else {
         return Ok(());
     };
@@ -82,15 +96,14 @@ pub fn command(
             node.get(),
             state_name(state)
         )?,
-        Err(DriveError::Io(e)) => return Err(io_failed(e)),
-        Err(_) if reset => {
+        Err(Error::DeadlinePassed) if reset => {
             return Err(LiveError::Failed(format!(
                 "node {} sent no boot-up message within {} s",
                 node.get(),
                 CONFIRM_WAIT.as_secs()
             )));
         }
-        Err(_) => {
+        Err(Error::DeadlinePassed) => {
             return Err(LiveError::Failed(format!(
                 "node {} sent no heartbeat in state {} within {} s (is its heartbeat, 0x1017, on?)",
                 node.get(),
@@ -98,6 +111,7 @@ pub fn command(
                 CONFIRM_WAIT.as_secs()
             )));
         }
+        Err(e) => return Err(io_failed(e)),
     }
     Ok(())
 }
@@ -135,8 +149,8 @@ fn run(
     mut f: impl FnMut(&MasterEvent) -> ControlFlow<()>,
 ) -> Result<(), LiveError> {
     match m.run_until(deadline, |e| f(e)) {
-        Ok(()) | Err(DriveError::Deadline | DriveError::Stopped) => Ok(()),
-        Err(DriveError::Io(e)) => Err(io_failed(e)),
+        Ok(()) | Err(Error::DeadlinePassed) => Ok(()),
+        Err(e) => Err(io_failed(e)),
     }
 }
 
@@ -218,7 +232,10 @@ pub fn scan(
         for sub in 1..=4u8 {
             match m.upload(node, 0x1018, sub) {
                 Ok(data) => entry.identity[usize::from(sub - 1)] = u32_of(&data),
-                Err(eds2rust_runtime::blocking::Error::Sdo(SdoError::Timeout)) => break,
+                Err(eds2rust_runtime::blocking::Error::Sdo {
+                    error: SdoError::Timeout,
+                    ..
+                }) => break,
                 Err(_) => {}
             }
         }

@@ -111,7 +111,10 @@ pub fn transfer_error(
     timeout: Duration,
 ) -> LiveError {
     let why = match error {
-        blocking::Error::Sdo(SdoError::Timeout) => format!(
+        blocking::Error::Sdo {
+            error: SdoError::Timeout,
+            ..
+        } => format!(
             "no answer within {} ms (is node {} on the bus?)",
             timeout.as_millis(),
             node.get()
@@ -171,7 +174,10 @@ pub fn read(
                 // command; an abort only this read.
                 let stop = matches!(
                     e,
-                    blocking::Error::Sdo(SdoError::Timeout) | blocking::Error::Io(_)
+                    blocking::Error::Sdo {
+                        error: SdoError::Timeout,
+                        ..
+                    } | blocking::Error::Io(_)
                 );
                 failed.push(transfer_error(node, &label, "read", &e, a.bus.timeout));
                 if stop {
@@ -350,7 +356,7 @@ pub fn download_file(
         // What a server without block transfer answers a block initiate with.
         let no_block = matches!(
             &e,
-            blocking::Error::Sdo(SdoError::RemoteAbort(code))
+            blocking::Error::Sdo { error: SdoError::RemoteAbort(code), .. }
                 if matches!(code.code(), 0x0504_0001 | 0x0504_0002 | 0x0601_0000 | 0x0800_0000)
         );
         if !a.segmented

@@ -278,6 +278,7 @@ fn nmt_and_scan() {
         verb: NmtVerb::Start,
         bus: bus_args(500),
         node: Some(32),
+        all: false,
         confirm: true,
     };
     let (out, r) = run(|o| nmt::command(|| Ok(sim.bus()), &args, o));
@@ -286,6 +287,15 @@ fn nmt_and_scan() {
         out,
         "sent NMT start to node 32\nnode 32: operational (heartbeat)\n"
     );
+    // Neither a node nor --all: nothing is sent, no broadcast by default.
+    let args = NmtArgs {
+        node: None,
+        confirm: false,
+        ..args
+    };
+    let (out, r) = run(|o| nmt::command(|| Ok(sim.bus()), &args, o));
+    assert!(matches!(r, Err(LiveError::Usage(_))), "{r:?}");
+    assert_eq!(out, "");
 }
 
 #[test]

@@ -139,7 +139,7 @@ fn a_corpus_drive_is_read_written_started_and_enabled() {
     assert_eq!(u32_of(&m.upload(node, 0x1018, 1).unwrap()), 0x555);
     m.download(node, 0x1017, 0, &100u16.to_le_bytes()).unwrap();
     assert_eq!(m.upload(node, 0x1017, 0).unwrap(), 100u16.to_le_bytes());
-    m.nmt(NmtCommand::Start, Some(node)).unwrap();
+    m.nmt(NmtCommand::Start, node).unwrap();
     let beats = count(&mut tap, 0x705, 0x05, Duration::from_millis(450));
     assert!((2..=6).contains(&beats), "{beats} operational heartbeats");
     for (cw, mask, sw) in [(0x06, 0x6F, 0x21), (0x07, 0x6F, 0x23), (0x0F, 0x6F, 0x27)] {

@@ -27,7 +27,7 @@ fn node(id: u8) -> NodeId {
 /// The abort code an SDO transfer failed with.
 fn abort_code<T>(result: std::result::Result<T, blocking::Error>) -> Option<AbortCode> {
     match result {
-        Err(blocking::Error::Sdo(SdoError::RemoteAbort(code))) => Some(code),
+        Err(blocking::Error::Sdo { error: SdoError::RemoteAbort(code), .. }) => Some(code),
         _ => None,
     }
 }
@@ -81,7 +81,7 @@ fn boots_answers_sdo_and_sends_its_tpdo() -> Result {
     assert_eq!(abort_code(raw), Some(AbortCode::WriteReadOnly));
 
     // Operational: the belt runs and TPDO1 reports it.
-    m.nmt(NmtCommand::Start, Some(drive))?;
+    m.nmt(NmtCommand::Start, drive)?;
     let deadline = WallClock::now() + TIMEOUT;
     let status = loop {
         let status = next_status(&mut m, drive)?;

@@ -11,17 +11,18 @@ use std::vec::Vec;
 mod drive;
 pub(crate) mod lss;
 
-pub use drive::{Cia402Error, DRIVE_EVENTS_KEPT, DriveHandle};
+pub use drive::{DRIVE_EVENTS_KEPT, DriveHandle};
 pub use lss::LssRequestError;
 
 use super::{
-    DriveError, Error, IDLE_WAIT, Transfer, Upload, encode, give_up, transfer_end, visible_string,
+    Error, IDLE_WAIT, Object, RunError, Transfer, Upload, encode, give_up, transfer_end,
+    visible_string,
 };
 use crate::master::{self, MasterEvent};
-use crate::nmt::NmtCommand;
+use crate::nmt::{NmtCommand, NmtTarget};
 use crate::od::{self, Entry, NodeId};
 use crate::pdo::PdoConfig;
-use crate::pdo::blocking::{PdoConfigError, SdoAccess, run_steps};
+use crate::pdo::blocking::{SdoAccess, run_steps};
 use crate::sdo::client::Method;
 use crate::sdo::typed::{self, LengthNote};
 use crate::time::Deadline;
@@ -46,7 +47,7 @@ pub const MASTER_QUEUE_CAPACITY: usize = 1024;
 /// use core::time::Duration;
 /// use eds2rust_runtime::blocking::Master;
 /// use eds2rust_runtime::master;
-/// use eds2rust_runtime::nmt::NmtCommand;
+/// use eds2rust_runtime::nmt::{NmtCommand, NmtTarget};
 /// use eds2rust_runtime::od::NodeId;
 /// use eds2rust_runtime::transport::virtual_bus::VirtualBus;
 ///
@@ -55,15 +56,18 @@ pub const MASTER_QUEUE_CAPACITY: usize = 1024;
 /// let core = master::Master::new(NodeId::new(1).unwrap(), Duration::from_millis(100));
 /// let mut m = Master::new(bus.attach(), core);
 /// m.start()?; // boot-up message of node 1
-/// m.nmt(NmtCommand::Start, NodeId::new(0x20))?;
+/// let node = NodeId::new(0x20).expect("1 to 127");
+/// m.nmt(NmtCommand::Start, NmtTarget::Node(node))?;
 /// m.run_for(Duration::from_millis(150))?; // one heartbeat
 /// let seen: Vec<String> = std::iter::from_fn(|| monitor.try_recv())
 ///     .map(|f| f.to_string())
 ///     .collect();
 /// assert_eq!(seen, ["701#00", "000#0120", "701#7F"]);
 /// // Typed SDO calls: m.read::<SomeEntry>(node)?, m.write::<SomeEntry>(node, value)?
-/// # Ok::<(), std::io::Error>(())
+/// # Ok::<(), eds2rust_runtime::blocking::Error>(())
 /// ```
+///
+/// Every call fails with the one [`Error`] of the drivers.
 #[derive(Debug)]
 pub struct Master<B> {
     bus: B,
@@ -132,14 +136,19 @@ impl<B: Bus> Master<B> {
 
     /// Starts the core ([`master::Master::start`]) and sends its boot-up
     /// message.
-    pub fn start(&mut self) -> io::Result<()> {
+    pub fn start(&mut self) -> Result<(), Error> {
         let now = self.now();
         self.core.start(now);
         self.flush()
     }
 
     /// Sends every frame the cores have ready.
-    pub fn flush(&mut self) -> io::Result<()> {
+    pub fn flush(&mut self) -> Result<(), Error> {
+        self.send_ready().map_err(Error::Io)
+    }
+
+    /// Sends every frame the cores have ready.
+    fn send_ready(&mut self) -> io::Result<()> {
         while let Some(frame) = self.core.poll_transmit() {
             self.bus.send(&frame)?;
         }
@@ -148,7 +157,7 @@ impl<B: Bus> Master<B> {
 
     /// Takes in the frames already received and the timers already due,
     /// without waiting, and sends what the cores have ready.
-    pub fn poll(&mut self) -> io::Result<()> {
+    pub fn poll(&mut self) -> Result<(), Error> {
         loop {
             let now = self.clock.now();
             if self.core.poll_timeout().is_some_and(|at| at <= now) {
@@ -164,16 +173,16 @@ impl<B: Bus> Master<B> {
     }
 
     /// Runs all cores for `duration`, queueing their events.
-    pub fn run_for(&mut self, duration: Duration) -> io::Result<()> {
+    pub fn run_for(&mut self, duration: Duration) -> Result<(), Error> {
         let deadline = self.now() + duration;
         match self.wait(Some(deadline), &mut Err::<(), _>) {
-            Ok(()) | Err(DriveError::Deadline | DriveError::Stopped) => Ok(()),
-            Err(DriveError::Io(e)) => Err(e),
+            Ok(()) | Err(RunError::Deadline | RunError::Stopped) => Ok(()),
+            Err(RunError::Io(e)) => Err(Error::Io(e)),
         }
     }
 
     /// Runs all cores until `until` breaks on an event or `deadline`
-    /// passes ([`DriveError::Deadline`]). Queued events are offered first,
+    /// passes ([`Error::DeadlinePassed`]). Queued events are offered first,
     /// oldest first. The event `until` breaks on is removed; the others
     /// stay queued.
     ///
@@ -184,7 +193,7 @@ impl<B: Bus> Master<B> {
         &mut self,
         deadline: impl Into<Deadline>,
         mut until: impl FnMut(&MasterEvent) -> ControlFlow<T>,
-    ) -> Result<T, DriveError> {
+    ) -> Result<T, Error> {
         let deadline = deadline.into().on(&self.clock);
         for i in 0..self.queue.len() {
             let Some(event) = self.queue.get(i) else {
@@ -195,23 +204,31 @@ impl<B: Bus> Master<B> {
                 return Ok(value);
             }
         }
-        self.wait(deadline, &mut |event| match until(&event) {
+        let result = self.wait(deadline, &mut |event| match until(&event) {
             ControlFlow::Break(value) => Ok(value),
             ControlFlow::Continue(()) => Err(event),
+        });
+        result.map_err(|e| match e {
+            RunError::Io(e) => Error::Io(e),
+            RunError::Deadline | RunError::Stopped => Error::DeadlinePassed,
         })
     }
 
-    /// The oldest queued event, or the next one within `timeout`
-    /// (`Ok(None)` when none came).
-    pub fn wait_event(&mut self, timeout: Duration) -> io::Result<Option<MasterEvent>> {
+    /// The oldest queued event, or the next one before `deadline`
+    /// (`Ok(None)` when none came). `deadline` is a [`Deadline`], as for
+    /// [`Master::run_until`].
+    pub fn wait_event(
+        &mut self,
+        deadline: impl Into<Deadline>,
+    ) -> Result<Option<MasterEvent>, Error> {
         if let Some(event) = self.queue.pop_front() {
             return Ok(Some(event));
         }
-        let deadline = self.now() + timeout;
-        match self.wait(Some(deadline), &mut Ok) {
+        let deadline = deadline.into().on(&self.clock);
+        match self.wait(deadline, &mut Ok) {
             Ok(event) => Ok(Some(event)),
-            Err(DriveError::Io(e)) => Err(e),
-            Err(DriveError::Deadline | DriveError::Stopped) => Ok(None),
+            Err(RunError::Io(e)) => Err(Error::Io(e)),
+            Err(RunError::Deadline | RunError::Stopped) => Ok(None),
         }
     }
 
@@ -281,29 +298,29 @@ impl<B: Bus> Master<B> {
         &mut self,
         deadline: Option<Instant>,
         until: &mut dyn FnMut(MasterEvent) -> Result<T, MasterEvent>,
-    ) -> Result<T, DriveError> {
+    ) -> Result<T, RunError> {
         self.wait_with(deadline, until, &mut |_, _| ControlFlow::Continue(()))
     }
 
     /// [`Master::wait`] with `hook` run first in every round (streamed
     /// transfers feed and take their data there); breaking from it stops
-    /// with [`DriveError::Stopped`].
+    /// with [`RunError::Stopped`].
     pub(super) fn wait_with<T>(
         &mut self,
         deadline: Option<Instant>,
         until: &mut dyn FnMut(MasterEvent) -> Result<T, MasterEvent>,
         hook: &mut dyn FnMut(&mut master::Master, Instant) -> ControlFlow<()>,
-    ) -> Result<T, DriveError> {
+    ) -> Result<T, RunError> {
         loop {
             if hook(&mut self.core, self.clock.now()).is_break() {
-                return Err(DriveError::Stopped);
+                return Err(RunError::Stopped);
             }
-            self.flush().map_err(DriveError::Io)?;
+            self.send_ready().map_err(RunError::Io)?;
             while let Some(event) = self.core.poll_event() {
                 match until(event) {
                     Ok(value) => {
                         // Best effort: a bus error shows again on the next call.
-                        let _ = self.flush();
+                        let _ = self.send_ready();
                         self.pump();
                         return Ok(value);
                     }
@@ -312,7 +329,7 @@ impl<B: Bus> Master<B> {
             }
             let now = self.clock.now();
             if deadline.is_some_and(|deadline| now >= deadline) {
-                return Err(DriveError::Deadline);
+                return Err(RunError::Deadline);
             }
             let timer = self.core.poll_timeout();
             if let Some(at) = timer
@@ -325,17 +342,23 @@ impl<B: Bus> Master<B> {
             for limit in [deadline, timer].into_iter().flatten() {
                 wake = wake.min(limit);
             }
-            if let Some(frame) = self.bus.recv(wake - now).map_err(DriveError::Io)? {
+            if let Some(frame) = self.bus.recv(wake - now).map_err(RunError::Io)? {
                 self.core.handle_frame(self.clock.now(), &frame);
             }
         }
     }
 
-    /// Sends NMT `cmd` to `target` (`None`: all nodes).
-    pub fn nmt(&mut self, cmd: NmtCommand, target: Option<NodeId>) -> io::Result<()> {
+    /// Sends NMT `cmd` to `target`: one node ([`NmtTarget::Node`]) or,
+    /// spelled out, every node ([`NmtTarget::All`]). A full NMT queue is
+    /// sent first; [`Error::NmtQueueFull`] when it stays full.
+    pub fn nmt(&mut self, cmd: NmtCommand, target: impl Into<NmtTarget>) -> Result<(), Error> {
+        let target = target.into();
         if self.core.nmt.send(cmd, target).is_err() {
             self.flush()?;
-            self.core.nmt.send(cmd, target).map_err(io::Error::other)?;
+            self.core
+                .nmt
+                .send(cmd, target)
+                .map_err(|_| Error::NmtQueueFull)?;
         }
         self.flush()
     }
@@ -350,11 +373,12 @@ impl<B: Bus> Master<B> {
         // Events of transfers started on the core stay queued.
         self.pump();
         let now = self.now();
+        let object = Object::new(Some(node), index, sub);
         let client = self.core.sdo_or_default(node);
-        transfer.start(client, now, index, sub)?;
-        let deadline = now + transfer.bound(client.config());
-        let result = self.wait(Some(deadline), &mut |event| match event {
-            MasterEvent::Sdo(n, e) if n == node => match transfer_end(e.clone(), index, sub) {
+        transfer.start(client, now, object)?;
+        let limit = transfer.bound(client.config());
+        let result = self.wait(Some(now + limit), &mut |event| match event {
+            MasterEvent::Sdo(n, e) if n == node => match transfer_end(e.clone(), object) {
                 ControlFlow::Break(result) => Ok(result),
                 ControlFlow::Continue(()) => Err(MasterEvent::Sdo(n, e)),
             },
@@ -363,7 +387,7 @@ impl<B: Bus> Master<B> {
         match result {
             Ok(result) => result,
             Err(e) => {
-                let error = give_up(self.core.sdo_or_default(node), e);
+                let error = give_up(self.core.sdo_or_default(node), e, object, Some(limit));
                 // Best effort: the abort frame of a failing bus may not go.
                 let _ = self.flush();
                 Err(error)
@@ -449,7 +473,8 @@ impl<B: Bus> Master<B> {
         E: Entry<Value = od::bytes::VisibleString>,
         E::Access: od::Read,
     {
-        visible_string(self.upload(node, E::INDEX, E::SUBINDEX)?)
+        let data = self.upload(node, E::INDEX, E::SUBINDEX)?;
+        visible_string(data, Object::new(Some(node), E::INDEX, E::SUBINDEX))
     }
 
     /// Writes the bytes of a string, DOMAIN or other byte-valued entry.
@@ -524,7 +549,8 @@ impl<B: Bus> Master<B> {
     {
         let upload = self.transfer(node, E::INDEX, sub, Transfer::Upload(Method::Auto))?;
         let strict = self.core.sdo_or_default(node).config().strict_lengths;
-        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)?;
+        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)
+            .map_err(|e| Object::new(Some(node), E::INDEX, sub).value(e))?;
         if let Some(note) = note {
             typed::keep(&mut self.notes, (node, note));
         }
@@ -538,18 +564,15 @@ impl<B: Bus> Master<B> {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value)?;
+        let (buf, len) = encode::<E>(value, Object::new(Some(node), E::INDEX, sub))?;
         self.download(node, E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
     }
 
     /// Configures a PDO of `node` as [`crate::pdo::blocking::configure_pdo`]
-    /// does (same steps, read-backs and errors).
-    pub fn configure_pdo(
-        &mut self,
-        node: NodeId,
-        config: &PdoConfig<'_>,
-    ) -> Result<(), PdoConfigError> {
-        run_steps(&mut NodeSdo { master: self, node }, config)
+    /// does (same steps and read-backs; its error is
+    /// [`Error::PdoConfig`]).
+    pub fn configure_pdo(&mut self, node: NodeId, config: &PdoConfig<'_>) -> Result<(), Error> {
+        run_steps(&mut NodeSdo { master: self, node }, config).map_err(Error::from)
     }
 }
 

@@ -11,7 +11,7 @@ use std::format;
 use std::io::{self, Read, Write};
 use std::vec::Vec;
 
-use super::{DriveError, Error, Master, SdoClient, give_up, run, transfer_end};
+use super::{Error, Master, Object, RunError, SdoClient, give_up, run_loop, transfer_end};
 use crate::master::{self, MasterEvent};
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::AbortCode;
@@ -165,42 +165,45 @@ pub(crate) fn announced(size: Option<u64>) -> Result<Option<u32>, Error> {
     }
 }
 
-/// Starts a streamed download announcing `announced` bytes on `core`.
+/// Starts a streamed download of `object` announcing `announced` bytes on
+/// `core`.
 pub(crate) fn start_download(
     core: &mut client::SdoClient,
     now: Instant,
-    (index, sub): (u16, u8),
+    object: Object,
     announced: Option<u32>,
     method: Method,
 ) -> Result<(), Error> {
     while core.poll_event().is_some() {}
-    core.download_stream(now, index, sub, announced, method)
-        .map_err(|client::Busy| Error::Busy)
+    core.download_stream(now, object.index, object.sub, announced, method)
+        .map_err(|client::Busy| object.busy())
 }
 
-/// Starts a streamed upload on `core`.
+/// Starts a streamed upload of `object` on `core`.
 pub(crate) fn start_upload(
     core: &mut client::SdoClient,
     now: Instant,
-    (index, sub): (u16, u8),
+    object: Object,
     method: Method,
 ) -> Result<(), Error> {
     while core.poll_event().is_some() {}
-    core.upload_stream(now, index, sub, method)
-        .map_err(|client::Busy| Error::Busy)
+    core.upload_stream(now, object.index, object.sub, method)
+        .map_err(|client::Busy| object.busy())
 }
 
-/// The error of a streamed transfer the driver loop ended with `error`:
-/// the source's or sink's when the pump stopped it (the transfer is then
-/// aborted with 0x08000000), else what the loop says. The abort frame is
-/// left in `core` for the caller to send.
+/// The error of a streamed transfer of `object` (bounded by `limit`) the
+/// driver loop ended with `error`: the source's or sink's when the pump
+/// stopped it (the transfer is then aborted with 0x08000000), else what
+/// the loop says. The abort frame is left in `core` for the caller to send.
 pub(crate) fn stream_error<R, W, P>(
     core: &mut client::SdoClient,
     pump: &mut Pump<'_, R, W, P>,
-    error: DriveError,
+    error: RunError,
+    object: Object,
+    limit: Option<Duration>,
 ) -> Error {
     let Some(stop) = pump.stop.take() else {
-        return give_up(core, error);
+        return give_up(core, error, object, limit);
     };
     if !core.is_idle() {
         core.abort(AbortCode::GeneralError);
@@ -270,11 +273,12 @@ impl<B: Bus> SdoClient<B> {
     ) -> Result<(), Error> {
         let now = self.clock.now();
         let announced = announced(size)?;
-        start_download(&mut self.core, now, (index, sub), announced, method)?;
+        let object = self.object(index, sub);
+        start_download(&mut self.core, now, object, announced, method)?;
         let len = announced.map(|s| s as usize);
         let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
         let total = bound(len, self.core.config());
-        self.run_stream(index, sub, &mut pump, now, total)?;
+        self.run_stream(object, &mut pump, now, total)?;
         finish_download(&mut pump);
         Ok(())
     }
@@ -294,10 +298,11 @@ impl<B: Bus> SdoClient<B> {
         progress: impl FnMut(Progress),
     ) -> Result<usize, Error> {
         let now = self.clock.now();
-        start_upload(&mut self.core, now, (index, sub), method)?;
+        let object = self.object(index, sub);
+        start_upload(&mut self.core, now, object, method)?;
         let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);
         let total = bound(Some(self.core.config().max_upload), self.core.config());
-        let rest = self.run_stream(index, sub, &mut pump, now, total)?;
+        let rest = self.run_stream(object, &mut pump, now, total)?;
         finish_upload(&mut pump, &rest)
     }
 
@@ -339,16 +344,15 @@ impl<B: Bus> SdoClient<B> {
     /// data the end event carried.
     fn run_stream<R: Read, W: Write, P: FnMut(Progress)>(
         &mut self,
-        index: u16,
-        sub: u8,
+        object: Object,
         pump: &mut Pump<'_, R, W, P>,
         started: Instant,
         bound: Option<Duration>,
     ) -> Result<Vec<u8>, Error> {
         let deadline = bound.map(|b| started + b);
-        let mut until = |event| transfer_end(event, index, sub);
+        let mut until = |event| transfer_end(event, object);
         let mut hook = |core: &mut client::SdoClient, now| pump.round(core, now);
-        let result = run(
+        let result = run_loop(
             &mut self.bus,
             &self.clock,
             &mut self.core,
@@ -361,7 +365,7 @@ impl<B: Bus> SdoClient<B> {
             Ok(Ok(upload)) => Ok(upload.data),
             Ok(Err(e)) => Err(e),
             Err(e) => {
-                let error = stream_error(&mut self.core, pump, e);
+                let error = stream_error(&mut self.core, pump, e, object, bound);
                 while let Some(frame) = self.core.poll_transmit() {
                     // Best effort: the abort frame of a failing bus may not go.
                     let _ = self.bus.send(&frame);
@@ -389,12 +393,13 @@ impl<B: Bus> Master<B> {
     ) -> Result<(), Error> {
         let now = self.now();
         let announced = announced(size)?;
+        let object = Object::new(Some(node), index, sub);
         let client = self.core_mut().sdo_or_default(node);
-        start_download(client, now, (index, sub), announced, method)?;
+        start_download(client, now, object, announced, method)?;
         let len = announced.map(|s| s as usize);
         let total = bound(len, client.config());
         let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
-        self.run_stream(node, (index, sub), &mut pump, now, total)?;
+        self.run_stream(node, object, &mut pump, now, total)?;
         finish_download(&mut pump);
         Ok(())
     }
@@ -411,25 +416,62 @@ impl<B: Bus> Master<B> {
         progress: impl FnMut(Progress),
     ) -> Result<usize, Error> {
         let now = self.now();
+        let object = Object::new(Some(node), index, sub);
         let client = self.core_mut().sdo_or_default(node);
-        start_upload(client, now, (index, sub), method)?;
+        start_upload(client, now, object, method)?;
         let total = bound(Some(client.config().max_upload), client.config());
         let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);
-        let rest = self.run_stream(node, (index, sub), &mut pump, now, total)?;
+        let rest = self.run_stream(node, object, &mut pump, now, total)?;
         finish_upload(&mut pump, &rest)
+    }
+
+    /// [`Master::download_from`] into the byte-valued entry `E` of `node`
+    /// (a DOMAIN such as program data 0x1F50, or a string): compiles only
+    /// for a writable one.
+    pub fn write_from<E>(
+        &mut self,
+        node: NodeId,
+        reader: &mut impl Read,
+        size: Option<u64>,
+        method: Method,
+        progress: impl FnMut(Progress),
+    ) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::ByteValue,
+    {
+        self.download_from(node, E::INDEX, E::SUBINDEX, reader, size, method, progress)
+    }
+
+    /// [`Master::upload_into`] from the byte-valued entry `E` of `node`:
+    /// compiles only for a readable one.
+    pub fn read_into<E>(
+        &mut self,
+        node: NodeId,
+        writer: &mut impl Write,
+        method: Method,
+        progress: impl FnMut(Progress),
+    ) -> Result<usize, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::ByteValue,
+    {
+        self.upload_into(node, E::INDEX, E::SUBINDEX, writer, method, progress)
     }
 
     fn run_stream<R: Read, W: Write, P: FnMut(Progress)>(
         &mut self,
         node: NodeId,
-        (index, sub): (u16, u8),
+        object: Object,
         pump: &mut Pump<'_, R, W, P>,
         started: Instant,
         bound: Option<Duration>,
     ) -> Result<Vec<u8>, Error> {
         let deadline = bound.map(|b| started + b);
         let mut until = |event| match event {
-            MasterEvent::Sdo(n, e) if n == node => match transfer_end(e.clone(), index, sub) {
+            MasterEvent::Sdo(n, e) if n == node => match transfer_end(e.clone(), object) {
                 ControlFlow::Break(result) => Ok(result),
                 ControlFlow::Continue(()) => Err(MasterEvent::Sdo(n, e)),
             },
@@ -440,7 +482,8 @@ impl<B: Bus> Master<B> {
             Ok(Ok(upload)) => Ok(upload.data),
             Ok(Err(e)) => Err(e),
             Err(e) => {
-                let error = stream_error(self.core_mut().sdo_or_default(node), pump, e);
+                let client = self.core_mut().sdo_or_default(node);
+                let error = stream_error(client, pump, e, object, bound);
                 // Best effort: the abort frame of a failing bus may not go.
                 let _ = self.flush();
                 Err(error)

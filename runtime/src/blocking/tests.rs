@@ -60,7 +60,7 @@ fn frame(id: u16, data: &[u8]) -> Frame {
 }
 
 #[test]
-fn drive_sends_feeds_frames_and_stops_on_break() {
+fn run_sends_feeds_frames_and_stops_on_break() {
     let bus = VirtualBus::new();
     let mut port = bus.attach();
     let peer = bus.attach();
@@ -68,16 +68,16 @@ fn drive_sends_feeds_frames_and_stops_on_break() {
     peer.transmit(&frame(0x200, &[1]));
     let clock = Clock::new();
     let mut core = Pinger::new(Some(frame(0x100, &[7])), 0x200, Duration::from_secs(60));
-    let got = drive(
+    let got = run(
         &mut port,
         &clock,
         &mut core,
+        // A deadline in the cores' own time.
+        clock.now() + Duration::from_secs(5),
         |event| match event {
             PingEvent::Got(frame) => ControlFlow::Break(frame),
             PingEvent::Tick(_) => ControlFlow::Continue(()),
         },
-        // A deadline in the cores' own time.
-        clock.now() + Duration::from_secs(5),
     )
     .unwrap();
     assert_eq!(got, frame(0x200, &[1]));
@@ -86,26 +86,26 @@ fn drive_sends_feeds_frames_and_stops_on_break() {
 }
 
 #[test]
-fn drive_runs_timers_and_honours_the_deadline() {
+fn run_runs_timers_and_honours_the_deadline() {
     let bus = VirtualBus::new();
     let mut port = bus.attach();
     let clock = Clock::new();
     let mut core = Pinger::new(None, 0x200, Duration::from_millis(10));
     let mut ticks = Vec::new();
     let start = std::time::Instant::now();
-    let result = drive(
+    let result = run(
         &mut port,
         &clock,
         &mut core,
+        start + Duration::from_millis(60),
         |event| {
             if let PingEvent::Tick(at) = event {
                 ticks.push(at);
             }
             ControlFlow::<()>::Continue(())
         },
-        start + Duration::from_millis(60),
     );
-    assert!(matches!(result, Err(DriveError::Deadline)));
+    assert!(matches!(result, Err(RunError::Deadline)));
     assert!(start.elapsed() >= Duration::from_millis(60));
     assert!((3..=6).contains(&ticks.len()), "{ticks:?}");
     // Each tick came at or after its deadline.
@@ -160,26 +160,20 @@ fn serve_ends_at_its_deadline() {
 }
 
 #[test]
-fn drive_and_serve_take_deadlines_in_the_cores_time() {
+fn run_and_serve_take_deadlines_in_the_cores_time() {
     let bus = VirtualBus::new();
     let mut port = bus.attach();
     let clock = Clock::new();
     let mut core = Pinger::new(None, 0x200, Duration::from_millis(10));
     let mut ticks = 0;
     let deadline = clock.now() + Duration::from_millis(35);
-    let result = drive(
-        &mut port,
-        &clock,
-        &mut core,
-        |event| {
-            if let PingEvent::Tick(_) = event {
-                ticks += 1;
-            }
-            ControlFlow::<()>::Continue(())
-        },
-        deadline,
-    );
-    assert!(matches!(result, Err(DriveError::Deadline)));
+    let result = run(&mut port, &clock, &mut core, deadline, |event| {
+        if let PingEvent::Tick(_) = event {
+            ticks += 1;
+        }
+        ControlFlow::<()>::Continue(())
+    });
+    assert!(matches!(result, Err(RunError::Deadline)));
     assert!(clock.now() >= deadline);
     assert!((1..=3).contains(&ticks), "{ticks}");
 
@@ -190,34 +184,35 @@ fn drive_and_serve_take_deadlines_in_the_cores_time() {
     // Deadline::NEVER with the stop flag already set: returns at once.
     stop.store(true, Ordering::Relaxed);
     serve(&mut port, &clock, &mut core, &stop, Deadline::NEVER, |_| {}).unwrap();
-    // A deadline already passed ends the drive before it waits.
-    let result = drive(
-        &mut port,
-        &clock,
-        &mut core,
-        |_| ControlFlow::<()>::Continue(()),
-        Instant::ZERO,
-    );
-    assert!(matches!(result, Err(DriveError::Deadline)));
+    // A deadline already passed ends the run before it waits.
+    let result = run(&mut port, &clock, &mut core, Instant::ZERO, |_| {
+        ControlFlow::<()>::Continue(())
+    });
+    assert!(matches!(result, Err(RunError::Deadline)));
 }
 
 #[test]
 fn visible_strings() {
-    assert_eq!(visible_string(b"Drive 1".to_vec()).unwrap(), "Drive 1");
-    assert_eq!(visible_string(b"ab\0\0\xFF".to_vec()).unwrap(), "ab");
-    assert_eq!(visible_string(Vec::new()).unwrap(), "");
+    let object = Object::new(NodeId::new(5), 0x1008, 0);
+    let text = |data: &[u8]| visible_string(data.to_vec(), object);
+    assert_eq!(text(b"Drive 1").unwrap(), "Drive 1");
+    assert_eq!(text(b"ab\0\0\xFF").unwrap(), "ab");
+    assert_eq!(text(b"").unwrap(), "");
     assert!(matches!(
-        visible_string(b"caf\xE9".to_vec()),
+        text(b"caf\xE9"),
         Err(Error::NotVisible {
+            index: 0x1008,
             offset: 3,
-            byte: 0xE9
+            byte: 0xE9,
+            ..
         })
     ));
     assert!(matches!(
-        visible_string(b"a\nb".to_vec()),
+        text(b"a\nb"),
         Err(Error::NotVisible {
             offset: 1,
-            byte: b'\n'
+            byte: b'\n',
+            ..
         })
     ));
 }
@@ -240,15 +235,54 @@ fn transfer_bound_counts_steps() {
 
 #[test]
 fn errors_display() {
-    let e = Error::Sdo(SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist));
+    let object = Object::new(NodeId::new(5), 0x1017, 0);
+    let e = object.sdo(SdoError::RemoteAbort(AbortCode::ObjectDoesNotExist));
     assert!(e.to_string().contains("0x06020000"), "{e}");
+    assert!(
+        e.to_string()
+            .starts_with("SDO transfer of 0x1017:0 with node 5: "),
+        "{e}"
+    );
     assert_eq!(
         Error::NotVisible {
+            node: None,
+            index: 0x1008,
+            sub: 0,
             offset: 2,
             byte: 0x80
         }
         .to_string(),
-        "byte 0x80 at offset 2 is not a visible character (0x20 to 0x7E)"
+        "0x1008:0 on the SDO server: byte 0x80 at offset 2 is not a visible character \
+         (0x20 to 0x7E); read the raw bytes instead"
     );
-    assert_eq!(DriveError::Deadline.to_string(), "the deadline passed");
+    assert_eq!(RunError::Deadline.to_string(), "the deadline passed");
+}
+
+#[test]
+fn a_transfer_past_its_limit_is_not_a_step_timeout() {
+    let object = Object::new(NodeId::new(5), 0x1F50, 1);
+    let mut core = client::SdoClient::new(ClientConfig::new(Channel::default_for(
+        NodeId::new(5).unwrap(),
+    )));
+    let limit = Duration::from_secs(3);
+    let e = give_up(&mut core, RunError::Deadline, object, Some(limit));
+    assert!(
+        matches!(e, Error::TransferTooLong { index: 0x1F50, sub: 1, limit: l, .. } if l == limit),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string().contains("took longer than its limit of 3s"),
+        "{e}"
+    );
+    // A step the server left unanswered is the core's timeout instead.
+    let step = object.sdo(SdoError::Timeout);
+    assert_eq!(step.sdo_error(), Some(SdoError::Timeout));
+}
+
+#[test]
+fn a_default_channel_names_its_node() {
+    let node = NodeId::new(0x22).unwrap();
+    assert_eq!(channel_node(Channel::default_for(node)), Some(node));
+    assert_eq!(channel_node(Channel::standard(0x622, 0x5A3)), None);
+    assert_eq!(channel_node(Channel::standard(0x600, 0x580)), None);
 }

@@ -6,9 +6,8 @@ use core::time::Duration;
 use crate::lss::fastscan::{Fastscan, KnownIdentity, Progress};
 use crate::lss::proto::{RangeField, Request, Response};
 use crate::lss::{
-    BitTiming, ERROR_NONE, Identity, IdentityField, IdentityRange, LssState, node_id_byte,
+    BitTiming, ERROR_NONE, Identity, IdentityField, IdentityRange, LssNodeId, LssState,
 };
-use crate::od::NodeId;
 use crate::queue::Ring;
 use crate::{Frame, Instant, Service};
 
@@ -214,15 +213,16 @@ impl LssMaster {
         self.start(now, Pending::Confirmed(Expect::Selected), &frames)
     }
 
-    /// Configure node id of the slave in the configuration state (`None`:
-    /// unconfigured, 0xFF). Ends with [`LssEvent::NodeIdConfigured`],
-    /// [`LssEvent::ConfigureFailed`] or [`LssEvent::NoResponse`].
+    /// Configure node id of the slave in the configuration state: a
+    /// [`NodeId`], or [`LssNodeId::Unconfigured`] (0xFF). Ends with
+    /// [`LssEvent::NodeIdConfigured`], [`LssEvent::ConfigureFailed`] or
+    /// [`LssEvent::NoResponse`].
     pub fn configure_node_id(
         &mut self,
         now: Instant,
-        node: Option<NodeId>,
+        node: impl Into<LssNodeId>,
     ) -> Result<(), LssError> {
-        let request = Request::ConfigureNodeId(node_id_byte(node));
+        let request = Request::ConfigureNodeId(node.into().to_byte());
         self.start(now, Pending::Confirmed(Expect::NodeId), &[request])
     }
 

@@ -119,7 +119,7 @@ fn configure_node_127_to_5_and_store() {
         LssEvent::Sent
     );
     assert_eq!(
-        bus.run(|m, now| m.configure_node_id(now, node(5))),
+        bus.run(|m, now| m.configure_node_id(now, node(5).unwrap())),
         LssEvent::NodeIdConfigured
     );
     assert_eq!(bus.run(LssMaster::store_configuration), LssEvent::Stored);
@@ -234,7 +234,7 @@ fn fastscan_then_configure() {
     // 133 steps of one timeout each.
     assert_eq!(bus.now, Instant::ZERO + DEFAULT_TIMEOUT * 133);
     assert_eq!(
-        bus.run(|m, now| m.configure_node_id(now, node(20))),
+        bus.run(|m, now| m.configure_node_id(now, node(20).unwrap())),
         LssEvent::NodeIdConfigured
     );
     assert_eq!(

@@ -4,7 +4,7 @@ use std::vec;
 use super::*;
 use crate::emcy::Emcy;
 use crate::lss::LssState;
-use crate::nmt::{NmtCommand, NmtState};
+use crate::nmt::{NmtCommand, NmtState, NmtTarget};
 use crate::sdo::SdoError;
 use crate::{CanId, Frame};
 
@@ -35,9 +35,15 @@ fn frames_come_from_the_cores_in_turn_each_in_its_own_order() {
     let mut m = Master::new(node(1), Duration::from_millis(100));
     m.add_sdo_client(node(5), ClientConfig::new(Channel::default_for(node(5))));
     m.start(ms(0));
-    m.nmt.send(NmtCommand::ResetCommunication, None).unwrap();
-    m.nmt.send(NmtCommand::Start, Some(node(5))).unwrap();
-    m.nmt.send(NmtCommand::Stop, Some(node(6))).unwrap();
+    m.nmt
+        .send(NmtCommand::ResetCommunication, NmtTarget::All)
+        .unwrap();
+    m.nmt
+        .send(NmtCommand::Start, NmtTarget::Node(node(5)))
+        .unwrap();
+    m.nmt
+        .send(NmtCommand::Stop, NmtTarget::Node(node(6)))
+        .unwrap();
     m.lss.switch_global(ms(0), LssState::Configuration).unwrap();
     m.sdo(node(5)).unwrap().upload(ms(0), 0x1018, 1).unwrap();
     assert_eq!(

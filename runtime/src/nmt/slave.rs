@@ -106,7 +106,7 @@ impl Service for NmtSlave {
 
     fn handle_frame(&mut self, _now: Instant, frame: &Frame) {
         if let Some((cmd, target)) = parse_command(frame)
-            && target.is_none_or(|node| node == self.node)
+            && target.includes(self.node)
         {
             self.apply(cmd);
         }

@@ -54,10 +54,7 @@ impl PdoConfigError {
     /// The abort code that ended a failed SDO access.
     pub fn abort_code(&self) -> Option<AbortCode> {
         match self {
-            PdoConfigError::Transfer {
-                error: Error::Sdo(e),
-                ..
-            } => Some(e.code()),
+            PdoConfigError::Transfer { error, .. } => error.sdo_error().map(SdoError::code),
             _ => None,
         }
     }
@@ -91,17 +88,13 @@ impl fmt::Display for PdoConfigError {
                     f,
                     "PDO configuration step {number} of {total} failed: {step}: "
                 )?;
-                match error {
-                    Error::Sdo(SdoError::RemoteAbort(code)) => {
-                        write!(f, "the device refused: {code}")?
-                    }
-                    Error::Sdo(SdoError::Timeout) => {
-                        f.write_str("the device did not answer in time")?
-                    }
-                    Error::Sdo(SdoError::LocalAbort(code)) => {
+                match error.sdo_error() {
+                    Some(SdoError::RemoteAbort(code)) => write!(f, "the device refused: {code}")?,
+                    Some(SdoError::Timeout) => f.write_str("the device did not answer in time")?,
+                    Some(SdoError::LocalAbort(code)) => {
                         write!(f, "the SDO client aborted the transfer: {code}")?
                     }
-                    other => other.fmt(f)?,
+                    _ => error.fmt(f)?,
                 }
                 if self.pdo_left_disabled() {
                     f.write_str("; the PDO is left disabled")?;

@@ -4,8 +4,6 @@
 
 use core::marker::PhantomData;
 use std::collections::{BTreeMap, VecDeque};
-use std::format;
-use std::io;
 use std::string::{String, ToString};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError};
 use std::vec::Vec;
@@ -28,7 +26,7 @@ use super::Error;
 use crate::blocking::{Upload, transfer_end};
 use crate::lss::LssEvent;
 use crate::master::{self, MasterEvent};
-use crate::nmt::NmtCommand;
+use crate::nmt::{NmtCommand, NmtTarget};
 use crate::od::{self, NodeId};
 use crate::pdo::{CobId, PdoEvent, WatchError};
 use crate::sdo::typed::LengthNote;
@@ -51,7 +49,7 @@ use stream::Queue;
 /// application's to decide. The driver ends when every [`Master`] handle
 /// is dropped (after sending the frames the cores still had), on a bus
 /// error, or when its future is dropped; pending calls then fail with
-/// [`Error::Io`] and the streams end.
+/// [`Error::DriverStopped`] and the streams end.
 ///
 /// Unlike the blocking master, whose cores run only during its calls, the
 /// cores run for as long as the driver does: heartbeats, SYNC, PDOs and
@@ -88,20 +86,21 @@ use stream::Queue;
 /// ```
 /// use core::time::Duration;
 /// use eds2rust_runtime::master;
-/// use eds2rust_runtime::nmt::NmtCommand;
+/// use eds2rust_runtime::nmt::{NmtCommand, NmtTarget};
 /// use eds2rust_runtime::od::NodeId;
 /// use eds2rust_runtime::tokio::Master;
 /// use eds2rust_runtime::transport::virtual_bus::VirtualBus;
 ///
 /// # #[tokio::main(flavor = "current_thread")]
-/// # async fn main() -> std::io::Result<()> {
+/// # async fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// let bus = VirtualBus::new();
 /// let monitor = bus.attach();
 /// let core = master::Master::new(NodeId::new(1).unwrap(), Duration::from_millis(100));
 /// let (m, driver) = Master::new(bus.attach(), core);
 /// let driver = tokio::spawn(driver.run());
 /// m.start().await?; // boot-up message of node 1
-/// m.nmt(NmtCommand::Start, NodeId::new(0x20)).await?;
+/// let node = NodeId::new(0x20).expect("1 to 127");
+/// m.nmt(NmtCommand::Start, NmtTarget::Node(node)).await?;
 /// tokio::time::sleep(Duration::from_millis(150)).await; // one heartbeat
 /// let seen: Vec<String> = std::iter::from_fn(|| monitor.try_recv())
 ///     .map(|f| f.to_string())
@@ -140,8 +139,7 @@ struct Shared {
 #[derive(Debug)]
 struct SdoWaiter {
     id: u64,
-    index: u16,
-    sub: u8,
+    object: crate::blocking::Object,
     reply: oneshot::Sender<Result<Upload, Error>>,
 }
 
@@ -164,7 +162,7 @@ struct State {
     /// The last of those rounds whose frames are all sent.
     sent: u64,
     /// Why the driver stopped, once it did.
-    stopped: Option<(io::ErrorKind, String)>,
+    stopped: Option<String>,
 }
 
 impl Shared {
@@ -180,13 +178,13 @@ impl Shared {
 
     /// Marks the driver stopped for `reason`: pending calls fail, streams
     /// end, NMT callers waiting for room wake.
-    fn stop(&self, reason: (io::ErrorKind, String)) {
+    fn stop(&self, reason: String) {
         let mut state = self.lock();
         if state.stopped.is_none() {
             state.stopped = Some(reason);
         }
         for (_, waiter) in core::mem::take(&mut state.sdo) {
-            let _ = waiter.reply.send(Err(Error::Io(state.stopped_error())));
+            let _ = waiter.reply.send(Err(state.stopped_error()));
         }
         // The LSS caller sees its sender dropped.
         state.lss = None;
@@ -203,17 +201,15 @@ impl Shared {
 
 impl State {
     /// The error of a call made after the driver stopped.
-    fn stopped_error(&self) -> io::Error {
-        match &self.stopped {
-            Some((kind, why)) => {
-                io::Error::new(*kind, format!("the master's driver stopped: {why}"))
-            }
-            None => io::Error::other("the master's driver is running"),
+    fn stopped_error(&self) -> Error {
+        let reason = self.stopped.as_deref().unwrap_or("it had not stopped");
+        Error::DriverStopped {
+            reason: reason.to_string(),
         }
     }
 
     /// `Err` once the driver stopped.
-    fn running(&self) -> io::Result<()> {
+    fn running(&self) -> Result<(), Error> {
         match self.stopped {
             Some(_) => Err(self.stopped_error()),
             None => Ok(()),
@@ -238,7 +234,7 @@ impl State {
                 let end = self
                     .sdo
                     .get(&node)
-                    .map(|w| transfer_end(e.clone(), w.index, w.sub));
+                    .map(|w| transfer_end(e.clone(), w.object));
                 if let Some(core::ops::ControlFlow::Break(result)) = end {
                     if let Some(waiter) = self.sdo.remove(&node) {
                         // A caller gone in the meantime no longer cares.
@@ -351,7 +347,7 @@ impl Master {
 
     /// Starts the core ([`master::Master::start`]) and returns once the
     /// driver sent its boot-up message. Fails once the driver stopped.
-    pub async fn start(&self) -> io::Result<()> {
+    pub async fn start(&self) -> Result<(), Error> {
         let round = {
             let mut state = self.shared.lock();
             state.running()?;
@@ -364,14 +360,14 @@ impl Master {
     }
 
     /// Returns once the driver sent every frame the cores have ready now.
-    pub async fn flush(&self) -> io::Result<()> {
+    pub async fn flush(&self) -> Result<(), Error> {
         let round = self.shared.lock().collected + 1;
         self.shared.wake.notify_one();
         self.sent(round).await
     }
 
     /// Waits until the frames of collection round `round` are sent.
-    async fn sent(&self, round: u64) -> io::Result<()> {
+    async fn sent(&self, round: u64) -> Result<(), Error> {
         loop {
             let flushed = self.shared.flushed.notified();
             let mut flushed = core::pin::pin!(flushed);
@@ -387,10 +383,13 @@ impl Master {
         }
     }
 
-    /// Sends NMT `cmd` to `target` (`None`: all nodes) and returns once
-    /// the driver sent it. When the NMT queue is full, waits for the
-    /// driver to send the queued frames first, then tries once more.
-    pub async fn nmt(&self, cmd: NmtCommand, target: Option<NodeId>) -> io::Result<()> {
+    /// Sends NMT `cmd` to `target` (one node, [`NmtTarget::Node`], or
+    /// spelled out, every node, [`NmtTarget::All`]) and returns once the
+    /// driver sent it. When the NMT queue is full, waits for the driver to
+    /// send the queued frames first, then tries once more
+    /// ([`Error::NmtQueueFull`] when it is still full).
+    pub async fn nmt(&self, cmd: NmtCommand, target: impl Into<NmtTarget>) -> Result<(), Error> {
+        let target = target.into();
         let mut tries = 0;
         loop {
             let (queued, round) = {
@@ -402,7 +401,7 @@ impl Master {
             self.sent(round).await?;
             match queued {
                 Ok(()) => return Ok(()),
-                Err(full) if tries > 0 => return Err(io::Error::other(full)),
+                Err(_) if tries > 0 => return Err(Error::NmtQueueFull),
                 Err(_) => tries += 1,
             }
         }
@@ -495,9 +494,6 @@ impl Drop for Master {
 }
 
 /// The reason recorded when the driver ends because every handle is gone.
-fn handles_gone() -> (io::ErrorKind, String) {
-    (
-        io::ErrorKind::NotConnected,
-        "every Master handle was dropped".to_string(),
-    )
+fn handles_gone() -> String {
+    "every Master handle was dropped".to_string()
 }

@@ -53,7 +53,7 @@ pub fn frames(data: &[u8]) -> Vec<(Duration, Frame)> {
 
 /// Feeds frames to a core, checking that every input yields a bounded number
 /// of frames and events and that deadlines are honoured.
-fn drive<S: Service>(
+fn feed<S: Service>(
     core: &mut S,
     input: &[(Duration, Frame)],
     mut on_frame: impl FnMut(&mut S, Frame),
@@ -161,7 +161,7 @@ pub fn sdo_server(data: &[u8]) {
     config.block_size = 4;
     let mut server = SdoServer::new(config, test_store());
     let input = to_channel(frames(data), channel().request);
-    drive(&mut server, &input, |_, frame| {
+    feed(&mut server, &input, |_, frame| {
         assert_eq!(frame.id(), channel().response);
         assert_eq!(frame.len(), 8);
     });
@@ -224,12 +224,12 @@ pub fn nmt_and_error_control(data: &[u8]) {
         let _ = parse_command(f);
         let _ = parse_heartbeat(f);
     }
-    drive(&mut NmtMaster::new(), &input, |_, _| {});
+    feed(&mut NmtMaster::new(), &input, |_, _| {});
     let mut consumer = HeartbeatConsumer::new();
     for node in 1..=8 {
         consumer.monitor(NodeId::new(node).unwrap(), Duration::from_millis(100));
     }
-    drive(&mut consumer, &input, |_, _| {});
+    feed(&mut consumer, &input, |_, _| {});
     let mut guard = NodeGuard::new();
     guard.guard(
         Instant::from_millis(1),
@@ -237,15 +237,15 @@ pub fn nmt_and_error_control(data: &[u8]) {
         Duration::from_millis(50),
         3,
     );
-    drive(&mut guard, &input, |_, _| {});
-    drive(
+    feed(&mut guard, &input, |_, _| {});
+    feed(
         &mut GuardResponder::new(NodeId::new(3).unwrap()),
         &input,
         |_, _| {},
     );
     let mut slave = NmtSlave::new(NodeId::new(3).unwrap());
     slave.boot_complete();
-    drive(&mut slave, &input, |_, _| {});
+    feed(&mut slave, &input, |_, _| {});
 }
 
 /// EMCY and SYNC: parsers and consumers on arbitrary frames.
@@ -259,8 +259,8 @@ pub fn emcy_and_sync(data: &[u8]) {
             assert_eq!(f.data(), [counter]);
         }
     }
-    drive(&mut EmcyConsumer::new(), &input, |_, _| {});
-    drive(&mut SyncConsumer::new(), &input, |_, _| {});
+    feed(&mut EmcyConsumer::new(), &input, |_, _| {});
+    feed(&mut SyncConsumer::new(), &input, |_, _| {});
 }
 
 /// candump lines: any text parses or fails with a reason; what parses writes
@@ -295,14 +295,14 @@ pub fn lss_frames(data: &[u8]) {
     }
     let input = frames(data);
     let identity = Identity::new(0x0000_0123, 0x4567, 1, 0x89AB);
-    drive(
+    feed(
         &mut LssSlave::new(identity, None, BitTiming::standard(BitRate::Kbit250)),
         &input,
         |_, _| {},
     );
     let mut master = LssMaster::new();
     let _ = master.identify_non_configured(Instant::from_millis(1));
-    drive(&mut master, &input, |_, _| {});
+    feed(&mut master, &input, |_, _| {});
 }
 
 /// The PDO receiver fed arbitrary frames: bounded events, latest data never
@@ -315,5 +315,5 @@ pub fn pdo_receiver(data: &[u8]) {
             .watch(cob, len, Some(Duration::from_millis(100)))
             .expect("a valid COB-ID");
     }
-    drive(&mut receiver, &frames(data), |_, _| {});
+    feed(&mut receiver, &frames(data), |_, _| {});
 }

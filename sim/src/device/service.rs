@@ -2,7 +2,7 @@
 //! frames and [`SimEvent`]s out.
 
 use eds2rust_runtime::heartbeat::HeartbeatEvent;
-use eds2rust_runtime::nmt::{NmtState, parse_command};
+use eds2rust_runtime::nmt::{NmtState, NmtTarget, parse_command};
 use eds2rust_runtime::sync::parse_sync_on;
 use eds2rust_runtime::{Frame, Instant, Service};
 
@@ -17,7 +17,7 @@ impl<B: Behaviour> Service for Device<B> {
         self.handle_lss(now, frame);
         if let Some((cmd, target)) = parse_command(frame) {
             let me = self.node();
-            if target.is_none() || (target == me && me.is_some()) {
+            if target == NmtTarget::All || me.is_some_and(|me| target.includes(me)) {
                 self.handle_nmt(now, cmd);
             }
             return;

@@ -9,14 +9,13 @@ use core::ops::ControlFlow;
 use core::time::Duration;
 use std::boxed::Box;
 use std::collections::VecDeque;
-use std::io;
 use std::vec::Vec;
 
 use super::Master;
 use crate::Instant;
-use crate::blocking::{DriveError, Error};
+use crate::blocking::Error;
 use crate::cia402::session::{Action, OperationError, Read, Request, Session, SessionConfig};
-use crate::cia402::{Event, MissingObject, Move, State, Statusword, object};
+use crate::cia402::{Event, Move, State, Statusword, object};
 use crate::master::MasterEvent;
 use crate::od::{self, DataType, Entry, NodeId, ObjectInfo};
 use crate::pdo::PdoEvent;
@@ -25,62 +24,6 @@ use crate::transport::Bus;
 /// Events a [`DriveHandle`] without observer keeps for
 /// [`DriveHandle::take_events`]; the oldest beyond are dropped.
 pub const DRIVE_EVENTS_KEPT: usize = 1024;
-
-/// Why a CiA 402 call of [`Master`] failed.
-#[derive(Debug)]
-pub enum Cia402Error {
-    /// The request failed on the drive, or was refused before anything was
-    /// sent (a missing object, the wrong state).
-    Operation(OperationError),
-    /// An SDO transfer of (index, sub) failed.
-    Sdo {
-        /// The object index.
-        index: u16,
-        /// The sub-index.
-        sub: u8,
-        /// The error.
-        error: Error,
-    },
-    /// The bus failed while waiting.
-    Io(io::Error),
-}
-
-impl fmt::Display for Cia402Error {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Cia402Error::Operation(e) => e.fmt(f),
-            Cia402Error::Sdo {
-                index,
-                sub: 0,
-                error,
-            } => write!(f, "{index:#06X}: {error}"),
-            Cia402Error::Sdo { index, sub, error } => write!(f, "{index:#06X}:{sub}: {error}"),
-            Cia402Error::Io(e) => write!(f, "CAN bus error: {e}"),
-        }
-    }
-}
-
-impl std::error::Error for Cia402Error {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            Cia402Error::Operation(e) => Some(e),
-            Cia402Error::Sdo { error, .. } => Some(error),
-            Cia402Error::Io(e) => Some(e),
-        }
-    }
-}
-
-impl From<OperationError> for Cia402Error {
-    fn from(e: OperationError) -> Cia402Error {
-        Cia402Error::Operation(e)
-    }
-}
-
-impl From<MissingObject> for Cia402Error {
-    fn from(e: MissingObject) -> Cia402Error {
-        Cia402Error::Operation(OperationError::Missing(e))
-    }
-}
 
 /// The UNSIGNED16 objects the loop uploads, as entries for the typed read
 /// (length and padding rules of [`Master::read`]).
@@ -126,15 +69,15 @@ impl<B: Bus> Master<B> {
     /// let mut drive = m.drive(node, &OBJECTS, SessionConfig::default())?;
     /// drive.on_event(|at, event| println!("{at:?} {event:?}"));
     /// // drive.enable()?; drive.quick_stop()?; ...
-    /// # Ok::<(), eds2rust_runtime::blocking::Cia402Error>(())
+    /// # Ok::<(), eds2rust_runtime::blocking::Error>(())
     /// ```
     pub fn drive(
         &mut self,
         node: NodeId,
         objects: &'static [ObjectInfo],
         config: SessionConfig,
-    ) -> Result<DriveHandle<'_, B>, Cia402Error> {
-        let session = Session::new(objects, config)?;
+    ) -> Result<DriveHandle<'_, B>, Error> {
+        let session = Session::new(objects, config).map_err(OperationError::Missing)?;
         Ok(DriveHandle::new(self, node, session))
     }
 
@@ -147,7 +90,7 @@ impl<B: Bus> Master<B> {
         session: &mut Session,
         request: Request,
         on_event: &mut dyn FnMut(Instant, Event),
-    ) -> Result<(), Cia402Error> {
+    ) -> Result<(), Error> {
         session.start(self.now(), request)?;
         let result = self.drive_loop(node, session, on_event);
         if result.is_err() {
@@ -162,7 +105,7 @@ impl<B: Bus> Master<B> {
         node: NodeId,
         session: &mut Session,
         on_event: &mut dyn FnMut(Instant, Event),
-    ) -> Result<(), Cia402Error> {
+    ) -> Result<(), Error> {
         loop {
             let now = self.now();
             let action = session.poll_action(now);
@@ -172,17 +115,10 @@ impl<B: Bus> Master<B> {
             match action {
                 Action::Write(write) => {
                     let (index, sub) = (write.index, write.sub);
-                    self.download(node, index, sub, &write.value.to_le_bytes())
-                        .map_err(|error| Cia402Error::Sdo { index, sub, error })?;
+                    self.download(node, index, sub, &write.value.to_le_bytes())?;
                 }
                 Action::Read(Read::Statusword) => {
-                    let sw = self
-                        .read::<Word<{ object::STATUSWORD }>>(node)
-                        .map_err(|error| Cia402Error::Sdo {
-                            index: object::STATUSWORD,
-                            sub: 0,
-                            error,
-                        })?;
+                    let sw = self.read::<Word<{ object::STATUSWORD }>>(node)?;
                     session.on_statusword(self.now(), &sw.to_le_bytes());
                 }
                 Action::Read(Read::ErrorCode) => {
@@ -206,11 +142,11 @@ impl<B: Bus> Master<B> {
                         Ok((cob_id, data, len, at)) => {
                             session.on_pdo(cob_id, data.get(..len).unwrap_or(&[]), at);
                         }
-                        Err(DriveError::Deadline | DriveError::Stopped) => {}
-                        Err(DriveError::Io(e)) => return Err(Cia402Error::Io(e)),
+                        Err(Error::DeadlinePassed) => {}
+                        Err(e) => return Err(e),
                     }
                 }
-                Action::Done(result) => return result.map_err(Cia402Error::Operation),
+                Action::Done(result) => return result.map_err(Error::Cia402),
             }
         }
     }
@@ -270,7 +206,7 @@ impl<'a, B: Bus> DriveHandle<'a, B> {
     }
 
     /// Runs one request (every other call is this one).
-    pub fn request(&mut self, request: Request) -> Result<(), Cia402Error> {
+    pub fn request(&mut self, request: Request) -> Result<(), Error> {
         let observer = &mut self.observer;
         let log = &mut self.log;
         let mut on_event = |at: Instant, event: Event| match observer {
@@ -290,41 +226,42 @@ impl<'a, B: Bus> DriveHandle<'a, B> {
     /// [`DriveConfig::fault_reset_attempts`](crate::cia402::DriveConfig)
     /// times). A fault that stays gives [`OperationError::Fault`] with the
     /// error code read from 0x603F.
-    pub fn enable(&mut self) -> Result<(), Cia402Error> {
+    pub fn enable(&mut self) -> Result<(), Error> {
         self.request(Request::Enable)
     }
 
     /// Disable voltage, to Switch on disabled.
-    pub fn disable(&mut self) -> Result<(), Cia402Error> {
+    pub fn disable(&mut self) -> Result<(), Error> {
         self.request(Request::Disable)
     }
 
     /// Quick stop, to Quick stop active (or Switch on disabled).
-    pub fn quick_stop(&mut self) -> Result<(), Cia402Error> {
+    pub fn quick_stop(&mut self) -> Result<(), Error> {
         self.request(Request::QuickStop)
     }
 
     /// Resets a fault; nothing to do outside the fault states.
-    pub fn fault_reset(&mut self) -> Result<(), Cia402Error> {
+    pub fn fault_reset(&mut self) -> Result<(), Error> {
         self.request(Request::FaultReset)
     }
 
     /// A profile-position move (absolute, relative, immediate per
     /// `options`), until target reached. Needs Operation enabled; writes
     /// mode 1 first when the handle has not set it.
-    pub fn move_to(&mut self, target: i32, options: Move) -> Result<(), Cia402Error> {
+    pub fn move_to(&mut self, target: i32, options: Move) -> Result<(), Error> {
         self.request(Request::Move { target, options })
     }
 
     /// Profile velocity: writes `target` to 0x60FF (mode 3 first when not
-    /// set) and waits for target reached (bit 10) in a later statusword.
-    pub fn velocity(&mut self, target: i32) -> Result<(), Cia402Error> {
+    /// set) and waits for target reached (bit 10) in a later statusword
+    /// (the I/O form of [`Drive::set_velocity`](crate::cia402::Drive::set_velocity)).
+    pub fn set_velocity(&mut self, target: i32) -> Result<(), Error> {
         self.request(Request::Velocity(target))
     }
 
     /// Homing with `method` (0x6098; `None`: the drive's), until homing
     /// attained.
-    pub fn home(&mut self, method: Option<i8>) -> Result<(), Cia402Error> {
+    pub fn home(&mut self, method: Option<i8>) -> Result<(), Error> {
         self.request(Request::Home(method))
     }
 
@@ -335,7 +272,7 @@ impl<'a, B: Bus> DriveHandle<'a, B> {
         velocity: u32,
         acceleration: u32,
         deceleration: u32,
-    ) -> Result<(), Cia402Error> {
+    ) -> Result<(), Error> {
         self.request(Request::Profile {
             velocity,
             acceleration,
@@ -344,31 +281,32 @@ impl<'a, B: Bus> DriveHandle<'a, B> {
     }
 
     /// One cycle of cyclic synchronous position: writes `target` to 0x607A
-    /// (mode 8 first when not set) and takes one statusword.
-    pub fn csp_target(&mut self, target: i32) -> Result<(), Cia402Error> {
+    /// (mode 8 first when not set) and takes one statusword (the I/O form
+    /// of [`Drive::set_csp_target`](crate::cia402::Drive::set_csp_target)).
+    pub fn set_csp_target(&mut self, target: i32) -> Result<(), Error> {
         self.request(Request::CspTarget(target))
     }
 
     /// Cyclic synchronous position: one target of `targets` every
-    /// `period` ([`DriveHandle::csp_target`], then the master's cores run
+    /// `period` ([`DriveHandle::set_csp_target`], then the master's cores run
     /// — SYNC included — until the period is over). Stops at the first
     /// error (the drive left Operation enabled, a following error).
     pub fn run_csp(
         &mut self,
         period: Duration,
         targets: impl IntoIterator<Item = i32>,
-    ) -> Result<(), Cia402Error> {
+    ) -> Result<(), Error> {
         for target in targets {
             let next = self.master.now() + period;
-            self.csp_target(target)?;
+            self.set_csp_target(target)?;
             let left = next.saturating_duration_since(self.master.now());
-            self.master.run_for(left).map_err(Cia402Error::Io)?;
+            self.master.run_for(left)?;
         }
         Ok(())
     }
 
     /// A statusword uploaded now.
-    pub fn statusword(&mut self) -> Result<Statusword, Cia402Error> {
+    pub fn statusword(&mut self) -> Result<Statusword, Error> {
         self.request(Request::Statusword)?;
         Ok(self.session.drive().statusword().unwrap_or(Statusword(0)))
     }

@@ -4,30 +4,28 @@
 
 use core::fmt;
 use core::time::Duration;
-use std::io;
 
 use super::Master;
 use crate::Instant;
-use crate::blocking::DriveError;
+use crate::blocking::{Error, RunError};
 use crate::lss::{
     ConfigureService, Identity, IdentityField, KnownIdentity, LssError, LssEvent, LssMaster,
-    LssState,
+    LssNodeId, LssState,
 };
 use crate::master::MasterEvent;
-use crate::od::NodeId;
 use crate::transport::Bus;
 
 /// Timeouts an LSS request may take: fastscan waits out up to 133, plus
 /// slack.
 const LSS_STEPS: u32 = 140;
 
-/// Why an LSS call of [`Master`] failed.
-#[derive(Debug)]
+/// Why an LSS request of a master failed ([`Error::Lss`]; a bus failure
+/// is [`Error::Io`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum LssRequestError {
     /// Another LSS request is still in progress.
     Busy,
-    /// The bus failed (the request was cancelled).
-    Io(io::Error),
     /// No slave answered within the LSS timeout.
     NoResponse,
     /// The slave answered a configuration service with an error.
@@ -50,8 +48,9 @@ impl fmt::Display for LssRequestError {
             LssRequestError::Busy => f.write_str(
                 "an LSS request is already in progress; wait for its event before the next",
             ),
-            LssRequestError::Io(e) => write!(f, "CAN bus error: {e}"),
-            LssRequestError::NoResponse => f.write_str("no LSS slave answered in time"),
+            LssRequestError::NoResponse => f.write_str(
+                "no LSS slave answered in time; check that a slave is connected and in the state the request needs",
+            ),
             LssRequestError::Refused {
                 service,
                 error,
@@ -72,14 +71,7 @@ impl fmt::Display for LssRequestError {
     }
 }
 
-impl std::error::Error for LssRequestError {
-    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
-        match self {
-            LssRequestError::Io(e) => Some(e),
-            _ => None,
-        }
-    }
-}
+impl std::error::Error for LssRequestError {}
 
 impl<B: Bus> Master<B> {
     /// Starts an LSS request with `start` (given the LSS core and the
@@ -87,10 +79,10 @@ impl<B: Bus> Master<B> {
     pub fn lss(
         &mut self,
         start: impl FnOnce(&mut LssMaster, Instant) -> Result<(), LssError>,
-    ) -> Result<LssEvent, LssRequestError> {
+    ) -> Result<LssEvent, Error> {
         self.pump();
         let now = self.now();
-        start(&mut self.core.lss, now).map_err(|LssError| LssRequestError::Busy)?;
+        start(&mut self.core.lss, now).map_err(|LssError| Error::Lss(LssRequestError::Busy))?;
         let bound = self
             .core
             .lss
@@ -105,42 +97,43 @@ impl<B: Bus> Master<B> {
         result.map_err(|e| {
             self.core.lss.cancel();
             match e {
-                DriveError::Io(e) => LssRequestError::Io(e),
-                DriveError::Deadline | DriveError::Stopped => LssRequestError::NoResponse,
+                RunError::Io(e) => Error::Io(e),
+                RunError::Deadline | RunError::Stopped => Error::Lss(LssRequestError::NoResponse),
             }
         })
     }
 
     /// Switch state global: every LSS slave enters `state`.
-    pub fn lss_switch_global(&mut self, state: LssState) -> Result<(), LssRequestError> {
+    pub fn lss_switch_global(&mut self, state: LssState) -> Result<(), Error> {
         let r = self.lss(|lss, now| lss.switch_global(now, state));
         lss_outcome(r, |e| (e == LssEvent::Sent).then_some(()))
     }
 
     /// Switch state selective: the slave with `identity` enters the
     /// configuration state.
-    pub fn lss_switch_selective(&mut self, identity: Identity) -> Result<(), LssRequestError> {
+    pub fn lss_switch_selective(&mut self, identity: Identity) -> Result<(), Error> {
         let r = self.lss(|lss, now| lss.switch_selective(now, identity));
         lss_outcome(r, |e| (e == LssEvent::Selected).then_some(()))
     }
 
-    /// Configures the node id of the slave in the configuration state
-    /// (`None`: unconfigured); it takes effect at its next NMT reset
-    /// communication.
-    pub fn lss_configure_node_id(&mut self, node: Option<NodeId>) -> Result<(), LssRequestError> {
+    /// Configures the node id of the slave in the configuration state (a
+    /// [`NodeId`], or [`LssNodeId::Unconfigured`]); it takes effect at its
+    /// next NMT reset communication.
+    pub fn lss_configure_node_id(&mut self, node: impl Into<LssNodeId>) -> Result<(), Error> {
+        let node = node.into();
         let r = self.lss(|lss, now| lss.configure_node_id(now, node));
         lss_outcome(r, |e| (e == LssEvent::NodeIdConfigured).then_some(()))
     }
 
     /// Makes the slave in the configuration state store its configuration.
-    pub fn lss_store(&mut self) -> Result<(), LssRequestError> {
+    pub fn lss_store(&mut self) -> Result<(), Error> {
         let r = self.lss(|lss, now| lss.store_configuration(now));
         lss_outcome(r, |e| (e == LssEvent::Stored).then_some(()))
     }
 
     /// Inquires one part of the address of the slave in the configuration
     /// state.
-    pub fn lss_inquire_identity(&mut self, field: IdentityField) -> Result<u32, LssRequestError> {
+    pub fn lss_inquire_identity(&mut self, field: IdentityField) -> Result<u32, Error> {
         let r = self.lss(|lss, now| lss.inquire_identity(now, field));
         lss_outcome(r, |e| match e {
             LssEvent::Identity { field: f, value } if f == field => Some(value),
@@ -150,7 +143,7 @@ impl<B: Bus> Master<B> {
 
     /// Inquires the active node id of the slave in the configuration state
     /// (0xFF: none).
-    pub fn lss_inquire_node_id(&mut self) -> Result<u8, LssRequestError> {
+    pub fn lss_inquire_node_id(&mut self) -> Result<u8, Error> {
         let r = self.lss(|lss, now| lss.inquire_node_id(now));
         lss_outcome(r, |e| match e {
             LssEvent::NodeId(id) => Some(id),
@@ -160,10 +153,7 @@ impl<B: Bus> Master<B> {
 
     /// Fastscan: the address of one non-configured slave, now in the
     /// configuration state; `None` when there is none.
-    pub fn lss_fastscan(
-        &mut self,
-        known: KnownIdentity,
-    ) -> Result<Option<Identity>, LssRequestError> {
+    pub fn lss_fastscan(&mut self, known: KnownIdentity) -> Result<Option<Identity>, Error> {
         let r = self.lss(|lss, now| lss.fastscan(now, known));
         lss_outcome(r, |e| match e {
             LssEvent::Found(identity) => Some(Some(identity)),
@@ -175,14 +165,14 @@ impl<B: Bus> Master<B> {
 
 /// The value of an LSS request's end event, or the error it stands for.
 pub(crate) fn lss_outcome<T>(
-    result: Result<LssEvent, LssRequestError>,
+    result: Result<LssEvent, Error>,
     value: impl FnOnce(LssEvent) -> Option<T>,
-) -> Result<T, LssRequestError> {
+) -> Result<T, Error> {
     let event = result?;
     if let Some(v) = value(event) {
         return Ok(v);
     }
-    Err(match event {
+    Err(Error::Lss(match event {
         LssEvent::NoResponse => LssRequestError::NoResponse,
         LssEvent::ConfigureFailed {
             service,
@@ -194,5 +184,5 @@ pub(crate) fn lss_outcome<T>(
             spec,
         },
         other => LssRequestError::Unexpected(other),
-    })
+    }))
 }

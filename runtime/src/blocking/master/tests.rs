@@ -35,7 +35,7 @@ fn run_until_takes_a_deadline_in_the_cores_time() {
     let start = m.now();
     let deadline = m.now() + Duration::from_millis(50);
     let result = m.run_until(deadline, |_| ControlFlow::<()>::Continue(()));
-    assert!(matches!(result, Err(DriveError::Deadline)), "{result:?}");
+    assert!(matches!(result, Err(Error::DeadlinePassed)), "{result:?}");
     let end = m.now();
     assert!(end >= deadline, "returned at {end:?}, before {deadline:?}");
     assert!(end - start < Duration::from_secs(2), "{:?}", end - start);
@@ -73,14 +73,14 @@ fn a_passed_core_deadline_returns_at_once_and_std_deadlines_still_work() {
     let peer = bus.attach();
     let before = std::time::Instant::now();
     let result = m.run_until(m.now(), |_| ControlFlow::<()>::Continue(()));
-    assert!(matches!(result, Err(DriveError::Deadline)));
+    assert!(matches!(result, Err(Error::DeadlinePassed)));
     let result = m.run_until(Instant::ZERO, |_| ControlFlow::<()>::Continue(()));
-    assert!(matches!(result, Err(DriveError::Deadline)));
+    assert!(matches!(result, Err(Error::DeadlinePassed)));
     assert!(before.elapsed() < Duration::from_secs(1));
     // The std clock's instants are still taken (mapped through the clock).
     let deadline = std::time::Instant::now() + Duration::from_millis(30);
     let result = m.run_until(deadline, |_| ControlFlow::<()>::Continue(()));
-    assert!(matches!(result, Err(DriveError::Deadline)));
+    assert!(matches!(result, Err(Error::DeadlinePassed)));
     assert!(std::time::Instant::now() >= deadline);
     // The end of time: no overflow, the call ends on its event.
     peer.transmit(&Frame::new(CanId::Standard(0x707), &[0x00]).unwrap());
@@ -94,10 +94,13 @@ fn a_passed_core_deadline_returns_at_once_and_std_deadlines_still_work() {
 }
 
 #[test]
-fn wait_event_and_run_for_take_durations() {
+fn wait_event_takes_a_deadline_and_run_for_a_duration() {
     let (mut m, monitor, _bus) = rig();
     let start = m.now();
-    assert_eq!(m.wait_event(Duration::from_millis(30)).unwrap(), None);
+    assert_eq!(
+        m.wait_event(start + Duration::from_millis(30)).unwrap(),
+        None
+    );
     assert!(m.now() - start >= Duration::from_millis(30));
     let start = m.now();
     m.run_for(Duration::from_millis(45)).unwrap();

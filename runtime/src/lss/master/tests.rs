@@ -3,6 +3,7 @@
 
 use super::*;
 use crate::CanId;
+use crate::od::NodeId;
 
 fn ms(n: u64) -> Instant {
     Instant::from_millis(n)
@@ -101,7 +102,7 @@ fn only_the_matching_answer_completes() {
 #[test]
 fn configuration_errors_are_reported() {
     let mut m = LssMaster::new();
-    m.configure_node_id(ms(0), NodeId::new(5)).unwrap();
+    m.configure_node_id(ms(0), NodeId::new(5).unwrap()).unwrap();
     assert_eq!(sent(&mut m), [[0x11, 5, 0, 0, 0, 0, 0, 0]]);
     answer(&mut m, ms(1), [0x11, 1, 0, 0, 0, 0, 0, 0]);
     m.configure_bit_timing(ms(1), BitTiming { table: 0, index: 4 })
@@ -111,7 +112,7 @@ fn configuration_errors_are_reported() {
     m.store_configuration(ms(2)).unwrap();
     assert_eq!(sent(&mut m), [[0x17, 0, 0, 0, 0, 0, 0, 0]]);
     answer(&mut m, ms(3), [0x17, 2, 0, 0, 0, 0, 0, 0]);
-    m.configure_node_id(ms(3), None).unwrap();
+    m.configure_node_id(ms(3), LssNodeId::Unconfigured).unwrap();
     assert_eq!(sent(&mut m), [[0x11, 0xFF, 0, 0, 0, 0, 0, 0]]);
     answer(&mut m, ms(4), [0x11, 0, 0, 0, 0, 0, 0, 0]);
     assert_eq!(

@@ -14,8 +14,8 @@ use std::vec::Vec;
 
 use super::Master;
 use crate::Instant;
-use crate::blocking::Cia402Error;
-use crate::cia402::session::{Action, Read, Request, Session, SessionConfig};
+use crate::blocking::Error;
+use crate::cia402::session::{Action, OperationError, Read, Request, Session, SessionConfig};
 use crate::cia402::{Event, Move, State, Statusword, object};
 use crate::master::MasterEvent;
 use crate::od::{NodeId, ObjectInfo};
@@ -32,7 +32,7 @@ impl Master {
     ///
     /// ```no_run
     /// # async fn run(master: eds2rust_runtime::tokio::Master, objects: &'static [eds2rust_runtime::od::ObjectInfo])
-    /// # -> Result<(), eds2rust_runtime::blocking::Cia402Error> {
+    /// # -> Result<(), eds2rust_runtime::tokio::Error> {
     /// use eds2rust_runtime::cia402::{Move, SessionConfig};
     /// let node = eds2rust_runtime::od::NodeId::new(2).unwrap();
     /// let mut drive = master.drive(node, objects, SessionConfig::default())?;
@@ -48,8 +48,8 @@ impl Master {
         node: NodeId,
         objects: &'static [ObjectInfo],
         config: SessionConfig,
-    ) -> Result<DriveHandle, Cia402Error> {
-        let session = Session::new(objects, config)?;
+    ) -> Result<DriveHandle, Error> {
+        let session = Session::new(objects, config).map_err(OperationError::Missing)?;
         Ok(DriveHandle::new(self.clone(), node, session))
     }
 
@@ -65,7 +65,7 @@ impl Master {
         request: Request,
         pdos: Option<&mut Events>,
         on_event: &mut (dyn FnMut(Instant, Event) + Send),
-    ) -> Result<(), Cia402Error> {
+    ) -> Result<(), Error> {
         session.start(self.now(), request)?;
         let mut guard = CancelOnDrop(Some(session));
         let session = guard.0.as_deref_mut().expect("set above");
@@ -82,7 +82,7 @@ impl Master {
         session: &mut Session,
         mut pdos: Option<&mut Events>,
         on_event: &mut (dyn FnMut(Instant, Event) + Send),
-    ) -> Result<(), Cia402Error> {
+    ) -> Result<(), Error> {
         loop {
             let now = self.now();
             let action = session.poll_action(now);
@@ -93,18 +93,10 @@ impl Master {
                 Action::Write(write) => {
                     let (index, sub) = (write.index, write.sub);
                     self.download(node, index, sub, &write.value.to_le_bytes())
-                        .await
-                        .map_err(|error| Cia402Error::Sdo { index, sub, error })?;
+                        .await?;
                 }
                 Action::Read(Read::Statusword) => {
-                    let data = self
-                        .upload(node, object::STATUSWORD, 0)
-                        .await
-                        .map_err(|error| Cia402Error::Sdo {
-                            index: object::STATUSWORD,
-                            sub: 0,
-                            error,
-                        })?;
+                    let data = self.upload(node, object::STATUSWORD, 0).await?;
                     session.on_statusword(self.now(), &data);
                 }
                 Action::Read(Read::ErrorCode) => {
@@ -129,7 +121,7 @@ impl Master {
                         }
                     }
                 }
-                Action::Done(result) => return result.map_err(Cia402Error::Operation),
+                Action::Done(result) => return result.map_err(Error::Cia402),
             }
         }
     }
@@ -201,7 +193,7 @@ impl DriveHandle {
     }
 
     /// Runs one request (every other call is this one).
-    pub async fn request(&mut self, request: Request) -> Result<(), Cia402Error> {
+    pub async fn request(&mut self, request: Request) -> Result<(), Error> {
         let log = &mut self.log;
         let mut on_event = |at: Instant, event: Event| {
             if log.len() >= DRIVE_EVENTS_KEPT {
@@ -221,39 +213,39 @@ impl DriveHandle {
     }
 
     /// To Operation enabled from any state, resetting a fault.
-    pub async fn enable(&mut self) -> Result<(), Cia402Error> {
+    pub async fn enable(&mut self) -> Result<(), Error> {
         self.request(Request::Enable).await
     }
 
     /// Disable voltage, to Switch on disabled.
-    pub async fn disable(&mut self) -> Result<(), Cia402Error> {
+    pub async fn disable(&mut self) -> Result<(), Error> {
         self.request(Request::Disable).await
     }
 
     /// Quick stop, to Quick stop active (or Switch on disabled).
-    pub async fn quick_stop(&mut self) -> Result<(), Cia402Error> {
+    pub async fn quick_stop(&mut self) -> Result<(), Error> {
         self.request(Request::QuickStop).await
     }
 
     /// Resets a fault; nothing to do outside the fault states.
-    pub async fn fault_reset(&mut self) -> Result<(), Cia402Error> {
+    pub async fn fault_reset(&mut self) -> Result<(), Error> {
         self.request(Request::FaultReset).await
     }
 
     /// A profile-position move (absolute, relative, immediate per
     /// `options`), until target reached.
-    pub async fn move_to(&mut self, target: i32, options: Move) -> Result<(), Cia402Error> {
+    pub async fn move_to(&mut self, target: i32, options: Move) -> Result<(), Error> {
         self.request(Request::Move { target, options }).await
     }
 
     /// Profile velocity: `target` to 0x60FF, until target reached.
-    pub async fn velocity(&mut self, target: i32) -> Result<(), Cia402Error> {
+    pub async fn set_velocity(&mut self, target: i32) -> Result<(), Error> {
         self.request(Request::Velocity(target)).await
     }
 
     /// Homing with `method` (0x6098; `None`: the drive's), until homing
     /// attained.
-    pub async fn home(&mut self, method: Option<i8>) -> Result<(), Cia402Error> {
+    pub async fn home(&mut self, method: Option<i8>) -> Result<(), Error> {
         self.request(Request::Home(method)).await
     }
 
@@ -264,7 +256,7 @@ impl DriveHandle {
         velocity: u32,
         acceleration: u32,
         deceleration: u32,
-    ) -> Result<(), Cia402Error> {
+    ) -> Result<(), Error> {
         let request = Request::Profile {
             velocity,
             acceleration,
@@ -275,12 +267,12 @@ impl DriveHandle {
 
     /// One cyclic synchronous position target (0x607A, mode 8 first when
     /// not set).
-    pub async fn csp_target(&mut self, target: i32) -> Result<(), Cia402Error> {
+    pub async fn set_csp_target(&mut self, target: i32) -> Result<(), Error> {
         self.request(Request::CspTarget(target)).await
     }
 
     /// Cyclic synchronous position: one target of `targets` every
-    /// `period` ([`DriveHandle::csp_target`], then a sleep until the period
+    /// `period` ([`DriveHandle::set_csp_target`], then a sleep until the period
     /// is over; the driver keeps the cores, SYNC included, running). Stops
     /// at the first error (the drive left Operation enabled, a following
     /// error).
@@ -288,18 +280,18 @@ impl DriveHandle {
         &mut self,
         period: core::time::Duration,
         targets: impl IntoIterator<Item = i32>,
-    ) -> Result<(), Cia402Error> {
+    ) -> Result<(), Error> {
         let mut next = ::tokio::time::Instant::now();
         for target in targets {
             next += period;
-            self.csp_target(target).await?;
+            self.set_csp_target(target).await?;
             ::tokio::time::sleep_until(next).await;
         }
         Ok(())
     }
 
     /// A fresh statusword.
-    pub async fn statusword(&mut self) -> Result<Statusword, Cia402Error> {
+    pub async fn statusword(&mut self) -> Result<Statusword, Error> {
         self.request(Request::Statusword).await?;
         Ok(self.session.drive().statusword().unwrap_or(Statusword(0)))
     }
@@ -322,5 +314,11 @@ impl DriveHandle {
     /// The node.
     pub fn node(&self) -> NodeId {
         self.node
+    }
+
+    /// Ends the handle, keeping the session (the helper's state) for a
+    /// later [`DriveHandle::new`].
+    pub fn into_session(self) -> Session {
+        self.session
     }
 }

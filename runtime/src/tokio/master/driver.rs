@@ -14,8 +14,8 @@ use crate::{Frame, Service};
 /// the driver is the application's to run).
 ///
 /// Dropping the driver (or its `run` future) stops the master: pending
-/// calls fail with [`super::Error::Io`], the streams end, and later calls
-/// fail at once.
+/// calls fail with [`super::Error::DriverStopped`], the streams end, and
+/// later calls fail at once.
 #[derive(Debug)]
 pub struct Driver<B> {
     bus: B,
@@ -38,7 +38,7 @@ impl<B: AsyncBus> Driver<B> {
         let result = self.rounds().await;
         let reason = match &result {
             Ok(()) => handles_gone(),
-            Err(e) => (e.kind(), e.to_string()),
+            Err(e) => std::format!("the bus failed: {e}"),
         };
         self.shared.stop(reason);
         result
@@ -114,9 +114,6 @@ impl<B: AsyncBus> Driver<B> {
 impl<B> Drop for Driver<B> {
     /// A driver that did not finish `run` stops the master too.
     fn drop(&mut self) {
-        self.shared.stop((
-            io::ErrorKind::NotConnected,
-            "the driver was dropped".to_string(),
-        ));
+        self.shared.stop("the driver was dropped".to_string());
     }
 }

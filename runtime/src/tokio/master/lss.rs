@@ -4,11 +4,12 @@
 
 use ::tokio::sync::oneshot;
 
-use super::{LssRequestError, Master, Shared};
+use super::{Error, LssRequestError, Master, Shared};
 use crate::Instant;
 use crate::blocking::master::lss::lss_outcome;
-use crate::lss::{Identity, IdentityField, KnownIdentity, LssError, LssEvent, LssMaster, LssState};
-use crate::od::NodeId;
+use crate::lss::{
+    Identity, IdentityField, KnownIdentity, LssError, LssEvent, LssMaster, LssNodeId, LssState,
+};
 
 /// Cancels the LSS request of a call dropped before its end.
 struct Guard<'a> {
@@ -39,13 +40,14 @@ impl Master {
     pub async fn lss(
         &self,
         start: impl FnOnce(&mut LssMaster, Instant) -> Result<(), LssError>,
-    ) -> Result<LssEvent, LssRequestError> {
+    ) -> Result<LssEvent, Error> {
         let _turn = self.shared.lss_turn.lock().await;
         let (reply, id) = {
             let mut state = self.shared.lock();
-            state.running().map_err(LssRequestError::Io)?;
+            state.running()?;
             let now = self.shared.now();
-            start(&mut state.core.lss, now).map_err(|LssError| LssRequestError::Busy)?;
+            start(&mut state.core.lss, now)
+                .map_err(|LssError| Error::Lss(LssRequestError::Busy))?;
             let (tx, rx) = oneshot::channel();
             let id = state.next_id();
             state.lss = Some((id, tx));
@@ -59,41 +61,42 @@ impl Master {
         };
         let result = reply.await;
         guard.armed = false;
-        result.map_err(|_| LssRequestError::Io(self.shared.lock().stopped_error()))
+        result.map_err(|_| self.shared.lock().stopped_error())
     }
 
     /// Switch state global: every LSS slave enters `state`.
-    pub async fn lss_switch_global(&self, state: LssState) -> Result<(), LssRequestError> {
+    pub async fn lss_switch_global(&self, state: LssState) -> Result<(), Error> {
         let r = self.lss(|lss, now| lss.switch_global(now, state)).await;
         lss_outcome(r, |e| (e == LssEvent::Sent).then_some(()))
     }
 
     /// Switch state selective: the slave with `identity` enters the
     /// configuration state.
-    pub async fn lss_switch_selective(&self, identity: Identity) -> Result<(), LssRequestError> {
+    pub async fn lss_switch_selective(&self, identity: Identity) -> Result<(), Error> {
         let r = self
             .lss(|lss, now| lss.switch_selective(now, identity))
             .await;
         lss_outcome(r, |e| (e == LssEvent::Selected).then_some(()))
     }
 
-    /// Configures the node id of the slave in the configuration state
-    /// (`None`: unconfigured); it takes effect at its next NMT reset
-    /// communication.
-    pub async fn lss_configure_node_id(&self, node: Option<NodeId>) -> Result<(), LssRequestError> {
+    /// Configures the node id of the slave in the configuration state (a
+    /// node id, or [`LssNodeId::Unconfigured`]); it takes effect at its
+    /// next NMT reset communication.
+    pub async fn lss_configure_node_id(&self, node: impl Into<LssNodeId>) -> Result<(), Error> {
+        let node = node.into();
         let r = self.lss(|lss, now| lss.configure_node_id(now, node)).await;
         lss_outcome(r, |e| (e == LssEvent::NodeIdConfigured).then_some(()))
     }
 
     /// Makes the slave in the configuration state store its configuration.
-    pub async fn lss_store(&self) -> Result<(), LssRequestError> {
+    pub async fn lss_store(&self) -> Result<(), Error> {
         let r = self.lss(|lss, now| lss.store_configuration(now)).await;
         lss_outcome(r, |e| (e == LssEvent::Stored).then_some(()))
     }
 
     /// Inquires one part of the address of the slave in the configuration
     /// state.
-    pub async fn lss_inquire_identity(&self, field: IdentityField) -> Result<u32, LssRequestError> {
+    pub async fn lss_inquire_identity(&self, field: IdentityField) -> Result<u32, Error> {
         let r = self.lss(|lss, now| lss.inquire_identity(now, field)).await;
         lss_outcome(r, |e| match e {
             LssEvent::Identity { field: f, value } if f == field => Some(value),
@@ -103,7 +106,7 @@ impl Master {
 
     /// Inquires the active node id of the slave in the configuration state
     /// (0xFF: none).
-    pub async fn lss_inquire_node_id(&self) -> Result<u8, LssRequestError> {
+    pub async fn lss_inquire_node_id(&self) -> Result<u8, Error> {
         let r = self.lss(|lss, now| lss.inquire_node_id(now)).await;
         lss_outcome(r, |e| match e {
             LssEvent::NodeId(id) => Some(id),
@@ -113,10 +116,7 @@ impl Master {
 
     /// Fastscan: the address of one non-configured slave, now in the
     /// configuration state; `None` when there is none.
-    pub async fn lss_fastscan(
-        &self,
-        known: KnownIdentity,
-    ) -> Result<Option<Identity>, LssRequestError> {
+    pub async fn lss_fastscan(&self, known: KnownIdentity) -> Result<Option<Identity>, Error> {
         let r = self.lss(|lss, now| lss.fastscan(now, known)).await;
         lss_outcome(r, |e| match e {
             LssEvent::Found(identity) => Some(Some(identity)),

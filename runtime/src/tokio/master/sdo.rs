@@ -8,24 +8,31 @@ use ::tokio::sync::oneshot;
 
 use super::{Error, Master, SdoWaiter, Shared};
 use crate::Instant;
-use crate::blocking::{DriveError, Transfer, Upload, encode, give_up, visible_string};
+use crate::blocking::{Object, RunError, Transfer, Upload, encode, give_up, visible_string};
 use crate::od::{self, Entry, NodeId};
 use crate::pdo::PdoConfig;
-use crate::pdo::blocking::{PdoConfigError, SdoAccess, run_steps};
+use crate::pdo::blocking::{SdoAccess, run_steps};
 use crate::sdo::client::{self, Method};
 use crate::sdo::typed;
 
 /// Ends the transfer of a call that did not see its end (dropped, or past
-/// its bound): aborts it on the core and wakes the driver to send the
-/// abort. `None` when the transfer had already ended (its result is in the
-/// call's channel).
-fn abandon(shared: &Shared, node: NodeId, id: u64, why: DriveError) -> Option<Error> {
+/// its bound `limit`): aborts it on the core and wakes the driver to send
+/// the abort. `None` when the transfer had already ended (its result is in
+/// the call's channel).
+fn abandon(
+    shared: &Shared,
+    object: Object,
+    id: u64,
+    why: RunError,
+    limit: Option<Duration>,
+) -> Option<Error> {
+    let node = object.node?;
     let mut state = shared.lock();
     if state.sdo.get(&node).is_none_or(|w| w.id != id) {
         return None;
     }
     state.sdo.remove(&node);
-    let error = give_up(state.core.sdo_or_default(node), why);
+    let error = give_up(state.core.sdo_or_default(node), why, object, limit);
     drop(state);
     shared.wake.notify_one();
     Some(error)
@@ -37,7 +44,7 @@ type NoRound = fn(&mut client::SdoClient, Instant) -> Result<(), Error>;
 /// Abandons the transfer when the call's future is dropped before its end.
 struct Guard<'a> {
     shared: &'a Shared,
-    node: NodeId,
+    object: Object,
     id: u64,
     armed: bool,
 }
@@ -45,7 +52,7 @@ struct Guard<'a> {
 impl Drop for Guard<'_> {
     fn drop(&mut self) {
         if self.armed {
-            abandon(self.shared, self.node, self.id, DriveError::Stopped);
+            abandon(self.shared, self.object, self.id, RunError::Stopped, None);
         }
     }
 }
@@ -58,8 +65,9 @@ impl Master {
         sub: u8,
         transfer: Transfer<'_>,
     ) -> Result<Upload, Error> {
+        let object = Object::new(Some(node), index, sub);
         let start = |client: &mut client::SdoClient, now| {
-            transfer.start(client, now, index, sub)?;
+            transfer.start(client, now, object)?;
             Ok(Some(transfer.bound(client.config())))
         };
         self.run_transfer(node, index, sub, start, None::<NoRound>)
@@ -90,7 +98,8 @@ impl Master {
             state.turns.entry(node).or_default().clone()
         };
         let _turn = turn.lock_owned().await;
-        let (mut reply, deadline, id) = {
+        let object = Object::new(Some(node), index, sub);
+        let (mut reply, bound, deadline, id) = {
             let mut state = self.shared.lock();
             state.running()?;
             let now = self.shared.now();
@@ -100,16 +109,15 @@ impl Master {
             let id = state.next_id();
             let waiter = SdoWaiter {
                 id,
-                index,
-                sub,
+                object,
                 reply: tx,
             };
             state.sdo.insert(node, waiter);
-            (rx, bound.map(|b| now + b), id)
+            (rx, bound, bound.map(|b| now + b), id)
         };
         let mut guard = Guard {
             shared: &self.shared,
-            node,
+            object,
             id,
             armed: true,
         };
@@ -151,13 +159,13 @@ impl Master {
         guard.armed = false;
         let result = match result {
             Some(result) => result.ok(),
-            None => match abandon(&self.shared, node, id, DriveError::Deadline) {
+            None => match abandon(&self.shared, object, id, RunError::Deadline, bound) {
                 Some(error) => return Err(error),
                 None => reply.try_recv().ok(),
             },
         };
         // A dropped sender: the driver stopped.
-        result.unwrap_or_else(|| Err(Error::Io(self.shared.lock().stopped_error())))
+        result.unwrap_or_else(|| Err(self.shared.lock().stopped_error()))
     }
 
     /// Reads (index, sub) of `node` with [`Method::Auto`]. A node without
@@ -296,7 +304,8 @@ impl Master {
         E: Entry<Value = od::bytes::VisibleString>,
         E::Access: od::Read,
     {
-        visible_string(self.upload(node, E::INDEX, E::SUBINDEX).await?)
+        let data = self.upload(node, E::INDEX, E::SUBINDEX).await?;
+        visible_string(data, Object::new(Some(node), E::INDEX, E::SUBINDEX))
     }
 
     /// Writes the bytes of a string, DOMAIN or other byte-valued entry.
@@ -373,7 +382,8 @@ impl Master {
             .await?;
         let mut state = self.shared.lock();
         let strict = state.core.sdo_or_default(node).config().strict_lengths;
-        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)?;
+        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)
+            .map_err(|e| Object::new(Some(node), E::INDEX, sub).value(e))?;
         if let Some(note) = note {
             typed::keep(&mut state.notes, (node, note));
         }
@@ -387,7 +397,7 @@ impl Master {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value)?;
+        let (buf, len) = encode::<E>(value, Object::new(Some(node), E::INDEX, sub))?;
         self.download(node, E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
             .await
     }
@@ -395,22 +405,18 @@ impl Master {
     /// Configures a PDO of `node` as [`crate::pdo::blocking::configure_pdo`]
     /// does: the same check first (nothing is sent for an invalid
     /// configuration), the writes in the CiA 301 order, the read-backs, and
-    /// the same errors.
+    /// the same errors (as [`Error::PdoConfig`]).
     ///
     /// The steps are those of the blocking implementation itself: it is
     /// replayed over the answers of the transfers done so far, each run
     /// telling the next transfer to do, until it ends.
-    pub async fn configure_pdo(
-        &self,
-        node: NodeId,
-        config: &PdoConfig<'_>,
-    ) -> Result<(), PdoConfigError> {
+    pub async fn configure_pdo(&self, node: NodeId, config: &PdoConfig<'_>) -> Result<(), Error> {
         let mut replay = Replay::default();
         loop {
             replay.at = 0;
             let result = run_steps(&mut replay, config);
             let Some(request) = replay.next.take() else {
-                return result;
+                return result.map_err(Error::from);
             };
             let answer = match request {
                 Request::Download { index, sub, data } => self
@@ -448,12 +454,12 @@ impl Replay {
             Some(Ok(data)) => Ok(data.clone()),
             // A failed transfer ends the steps: it is the last answer and
             // is replayed once, by the run that returns.
-            Some(failed) => core::mem::replace(failed, Err(Error::Busy)),
+            Some(failed) => core::mem::replace(failed, Err(Error::SdoBusy { node: None })),
             None => {
                 if self.next.is_none() {
                     self.next = Some(request());
                 }
-                Err(Error::Busy)
+                Err(Error::SdoBusy { node: None })
             }
         }
     }

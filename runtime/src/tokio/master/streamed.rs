@@ -20,11 +20,11 @@ use std::vec::Vec;
 
 use super::{Error, Master};
 use crate::Instant;
-use crate::blocking::DriveError;
 use crate::blocking::stream::{
     Pump, announced, bound, finish_download, finish_upload, start_download, start_upload,
     stream_error,
 };
+use crate::blocking::{Object, RunError};
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::client::{self, Method, Progress};
 
@@ -53,8 +53,9 @@ impl Master {
         let announced = announced(size)?;
         let len = announced.map(|s| s as usize);
         let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
+        let object = Object::new(Some(node), index, sub);
         let start = |client: &mut client::SdoClient, now| {
-            start_download(client, now, (index, sub), announced, method)?;
+            start_download(client, now, object, announced, method)?;
             Ok(bound(len, client.config()))
         };
         self.run_stream(node, (index, sub), &mut pump, start)
@@ -81,8 +82,9 @@ impl Master {
         P: FnMut(Progress) + Send,
     {
         let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);
+        let object = Object::new(Some(node), index, sub);
         let start = |client: &mut client::SdoClient, now| {
-            start_upload(client, now, (index, sub), method)?;
+            start_upload(client, now, object, method)?;
             Ok(bound(Some(client.config().max_upload), client.config()))
         };
         let rest = self
@@ -151,7 +153,10 @@ impl Master {
         let round = |client: &mut client::SdoClient, now| match pump.round(client, now) {
             ControlFlow::Continue(()) => Ok(()),
             // The source or sink failed: its error, the abort queued.
-            ControlFlow::Break(()) => Err(stream_error(client, pump, DriveError::Stopped)),
+            ControlFlow::Break(()) => {
+                let object = Object::new(Some(node), index, sub);
+                Err(stream_error(client, pump, RunError::Stopped, object, None))
+            }
         };
         self.run_transfer(node, index, sub, start, Some(round))
             .await

@@ -1,12 +1,12 @@
 //! Stepping sans-IO cores over a bus, for the interop tests (the runtime's
-//! [`drive`] does the waiting; [`step`] gives frame-by-frame control).
+//! [`run`] does the waiting; [`step`] gives frame-by-frame control).
 
 use std::fmt;
 use std::ops::ControlFlow;
 use std::time::{Duration, Instant};
 
 use eds2rust_runtime::Service;
-use eds2rust_runtime::blocking::{DriveError, drive};
+use eds2rust_runtime::blocking::{RunError, run};
 use eds2rust_runtime::transport::{Bus, Clock};
 
 /// Drives a sans-IO core over `bus` for one step: sends what it has
@@ -55,7 +55,7 @@ pub fn flush<S: Service>(bus: &mut impl Bus, service: &mut S) -> Result<(), Stri
     Ok(())
 }
 
-/// Runs `service` with the runtime's [`drive`] until `pick` accepts one of
+/// Runs `service` with the runtime's [`run`] until `pick` accepts one of
 /// its events, for at most `timeout`; the error names the events seen.
 pub fn run_until<S: Service, T>(
     bus: &mut impl Bus,
@@ -80,8 +80,8 @@ where
             }
         }
     };
-    drive(bus, clock, service, until, Instant::now() + timeout).map_err(|e| match e {
-        DriveError::Deadline => {
+    run(bus, clock, service, Instant::now() + timeout, until).map_err(|e| match e {
+        RunError::Deadline => {
             format!("no awaited event within {timeout:?}; events seen: {seen:?}")
         }
         other => format!("{other}; events seen: {seen:?}"),

@@ -1,0 +1,156 @@
+//! Streamed SDO transfers of the tokio [`SdoClient`]: a download read from
+//! an [`io::Read`] and an upload written to an [`io::Write`], neither held
+//! whole in memory, with a progress callback. The data side is the
+//! blocking driver's pump (`blocking::stream`), run in every round of the
+//! loop; see [`crate::tokio::Master::download_from`] for what a source
+//! that blocks means on a task.
+
+use core::time::Duration;
+use std::io::{self, Read, Write};
+use std::vec::Vec;
+
+use super::{Error, SdoClient, now, run_loop};
+use crate::blocking::Object;
+use crate::blocking::stream::{
+    Pump, announced, bound, finish_download, finish_upload, start_download, start_upload,
+    stream_error,
+};
+use crate::blocking::transfer_end;
+use crate::od::{self, Entry};
+use crate::sdo::client::{self, Method, Progress};
+use crate::transport::AsyncBus;
+use crate::{Instant, Service};
+
+impl<B: AsyncBus> SdoClient<B> {
+    /// Writes the value `reader` yields to (index, sub) without holding it
+    /// (see [`crate::blocking::SdoClient::download_from`]: `size`, `method`
+    /// and the errors are the same).
+    pub async fn download_from<R, P>(
+        &mut self,
+        index: u16,
+        sub: u8,
+        reader: &mut R,
+        size: Option<u64>,
+        method: Method,
+        progress: P,
+    ) -> Result<(), Error>
+    where
+        R: Read + Send,
+        P: FnMut(Progress) + Send,
+    {
+        let start = now(&self.clock);
+        let announced = announced(size)?;
+        let object = self.object(index, sub);
+        start_download(&mut self.core, start, object, announced, method)?;
+        let len = announced.map(|s| s as usize);
+        let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
+        let limit = bound(len, self.core.config());
+        self.run_stream(object, &mut pump, start, limit).await?;
+        finish_download(&mut pump);
+        Ok(())
+    }
+
+    /// Reads (index, sub) into `writer` as the data arrives; returns the
+    /// number of bytes (see [`crate::blocking::SdoClient::upload_into`]).
+    pub async fn upload_into<W, P>(
+        &mut self,
+        index: u16,
+        sub: u8,
+        writer: &mut W,
+        method: Method,
+        progress: P,
+    ) -> Result<usize, Error>
+    where
+        W: Write + Send,
+        P: FnMut(Progress) + Send,
+    {
+        let start = now(&self.clock);
+        let object = self.object(index, sub);
+        start_upload(&mut self.core, start, object, method)?;
+        let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);
+        let limit = bound(Some(self.core.config().max_upload), self.core.config());
+        let rest = self.run_stream(object, &mut pump, start, limit).await?;
+        finish_upload(&mut pump, &rest)
+    }
+
+    /// [`SdoClient::download_from`] into the byte-valued entry `E`:
+    /// compiles only for a writable one.
+    pub async fn write_from<E, R, P>(
+        &mut self,
+        reader: &mut R,
+        size: Option<u64>,
+        method: Method,
+        progress: P,
+    ) -> Result<(), Error>
+    where
+        E: Entry,
+        E::Access: od::Write,
+        E::Value: od::ByteValue,
+        R: Read + Send,
+        P: FnMut(Progress) + Send,
+    {
+        self.download_from(E::INDEX, E::SUBINDEX, reader, size, method, progress)
+            .await
+    }
+
+    /// [`SdoClient::upload_into`] from the byte-valued entry `E`: compiles
+    /// only for a readable one.
+    pub async fn read_into<E, W, P>(
+        &mut self,
+        writer: &mut W,
+        method: Method,
+        progress: P,
+    ) -> Result<usize, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::ByteValue,
+        W: Write + Send,
+        P: FnMut(Progress) + Send,
+    {
+        self.upload_into(E::INDEX, E::SUBINDEX, writer, method, progress)
+            .await
+    }
+
+    /// Runs a started streamed transfer to its end; returns the upload
+    /// data the end event carried.
+    async fn run_stream<R, W, P>(
+        &mut self,
+        object: Object,
+        pump: &mut Pump<'_, R, W, P>,
+        started: Instant,
+        limit: Option<Duration>,
+    ) -> Result<Vec<u8>, Error>
+    where
+        R: Read + Send,
+        W: Write + Send,
+        P: FnMut(Progress) + Send,
+    {
+        let deadline = limit.map(|b| started + b);
+        let mut until = |event| transfer_end(event, object);
+        let mut hook = |core: &mut client::SdoClient, now| pump.round(core, now);
+        let stop = core::future::pending();
+        let result = run_loop(
+            &mut self.bus,
+            &self.clock,
+            &mut self.core,
+            &mut until,
+            deadline,
+            stop,
+            &mut hook,
+        )
+        .await;
+        match result {
+            Ok(Ok(upload)) => Ok(upload.data),
+            Ok(Err(e)) => Err(e),
+            Err(e) => {
+                let error = stream_error(&mut self.core, pump, e, object, limit);
+                while let Some(frame) = self.core.poll_transmit() {
+                    // Best effort: the abort frame of a failing bus may not go.
+                    let _ = self.bus.send(&frame).await;
+                }
+                Err(error)
+            }
+        }
+    }
+}
