@@ -27,7 +27,10 @@ fn node(id: u8) -> NodeId {
 /// The abort code an SDO transfer failed with.
 fn abort_code<T>(result: std::result::Result<T, blocking::Error>) -> Option<AbortCode> {
     match result {
-        Err(blocking::Error::Sdo { error: SdoError::RemoteAbort(code), .. }) => Some(code),
+        Err(blocking::Error::Sdo {
+            error: SdoError::RemoteAbort(code),
+            ..
+        }) => Some(code),
         _ => None,
     }
 }

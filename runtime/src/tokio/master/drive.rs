@@ -9,6 +9,8 @@
 //! it mid-request aborts the SDO transfer in flight and cancels the request
 //! in the session, so the next request starts from the drive's state.
 
+use core::fmt;
+use std::boxed::Box;
 use std::collections::VecDeque;
 use std::vec::Vec;
 
@@ -157,18 +159,32 @@ impl Drop for CancelOnDrop<'_> {
     }
 }
 
+/// The observer of a [`DriveHandle`].
+type Observer = Box<dyn FnMut(Instant, &Event) + Send>;
+
 /// One CiA 402 drive on the tokio [`Master`] (see [`Master::drive`]): the
 /// async counterpart of [`blocking::DriveHandle`](crate::blocking::DriveHandle),
-/// with the same calls. The drive's [`Event`]s (state changes, faults) are
+/// with the same calls. The drive's [`Event`]s (state changes, faults) go
+/// to the observer ([`DriveHandle::on_event`]) as they happen, or else are
 /// kept for [`DriveHandle::take_events`] (the newest
 /// [`DRIVE_EVENTS_KEPT`]).
-#[derive(Debug)]
 pub struct DriveHandle {
     master: Master,
     node: NodeId,
     session: Session,
     pdos: Option<Events>,
+    observer: Option<Observer>,
     log: VecDeque<(Instant, Event)>,
+}
+
+impl fmt::Debug for DriveHandle {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("DriveHandle")
+            .field("node", &self.node)
+            .field("session", &self.session)
+            .field("observer", &self.observer.is_some())
+            .finish_non_exhaustive()
+    }
 }
 
 impl DriveHandle {
@@ -182,24 +198,36 @@ impl DriveHandle {
             node,
             session,
             pdos,
+            observer: None,
             log: VecDeque::new(),
         }
     }
 
-    /// The events since the last call (at most [`DRIVE_EVENTS_KEPT`], the
-    /// newest), each with the time it was seen.
+    /// Hands every event from now on to `observer` (with the time it was
+    /// seen) instead of keeping it.
+    pub fn on_event(&mut self, observer: impl FnMut(Instant, &Event) + Send + 'static) {
+        self.observer = Some(Box::new(observer));
+    }
+
+    /// The events kept since the last call (at most [`DRIVE_EVENTS_KEPT`],
+    /// the newest), each with the time it was seen, when no observer is
+    /// set.
     pub fn take_events(&mut self) -> Vec<(Instant, Event)> {
         self.log.drain(..).collect()
     }
 
     /// Runs one request (every other call is this one).
     pub async fn request(&mut self, request: Request) -> Result<(), Error> {
+        let observer = &mut self.observer;
         let log = &mut self.log;
-        let mut on_event = |at: Instant, event: Event| {
-            if log.len() >= DRIVE_EVENTS_KEPT {
-                log.pop_front();
+        let mut on_event = |at: Instant, event: Event| match observer {
+            Some(observer) => observer(at, &event),
+            None => {
+                if log.len() >= DRIVE_EVENTS_KEPT {
+                    log.pop_front();
+                }
+                log.push_back((at, event));
             }
-            log.push_back((at, event));
         };
         self.master
             .run_drive_request(
