@@ -361,7 +361,7 @@ impl Session<'_> {
             }
             // Reads are the master's business; RPDO writes come at the
             // PDO rate (their effect on a drive is shown by its events).
-            SimEvent::Sdo(ServerEvent::Uploaded { .. }) | SimEvent::Written { .. } => return None,
+            SimEvent::Sdo(_) | SimEvent::Written { .. } => return None,
             SimEvent::HeartbeatLost(n) => format!("heartbeat of node {n} lost"),
             SimEvent::HeartbeatResumed(n) => format!("heartbeat of node {n} resumed"),
             SimEvent::Emcy(code) => format!("EMCY {code:#06X}"),

@@ -204,6 +204,7 @@ pub const fn error_class(code: u16) -> &'static str {
 
 /// What an [`EmcyConsumer`] received.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum EmcyEvent {
     /// A well-formed emergency message from `node`.
     Emergency {

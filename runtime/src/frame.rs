@@ -42,6 +42,7 @@ impl CanId {
 
 /// Why a frame could not be built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum FrameError {
     /// More than 8 data bytes.
     TooLong(usize),

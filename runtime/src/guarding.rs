@@ -34,6 +34,7 @@ pub const fn guard_reply(node: NodeId, toggle: bool, state: NmtState) -> Frame {
 
 /// What a [`NodeGuard`] observed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum GuardEvent {
     /// The node reported a new state (every boot-up message is reported).
     State {
@@ -253,6 +254,7 @@ impl Service for NodeGuard {
 
 /// What a [`GuardResponder`] observed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum GuardResponderEvent {
     /// Life guarding: no request from the master within the life time after
     /// the previous one (reported once per loss).

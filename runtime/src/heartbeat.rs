@@ -188,6 +188,7 @@ impl Service for HeartbeatProducer {
 
 /// What a [`HeartbeatConsumer`] observed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum HeartbeatEvent {
     /// No heartbeat within the consumer time (reported once per loss).
     Timeout {

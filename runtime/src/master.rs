@@ -79,6 +79,7 @@ const FIXED_CORES: usize = 8;
 
 /// What one of the master's cores reported.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum MasterEvent {
     /// The NMT master saw a boot-up or a state change of a node.
     Nmt(NmtEvent),

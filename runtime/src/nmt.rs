@@ -241,6 +241,7 @@ impl core::error::Error for QueueFull {}
 
 /// What an [`NmtMaster`] observed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum NmtEvent {
     /// The node sent its boot-up message (it was reset or powered on).
     BootUp(NodeId),

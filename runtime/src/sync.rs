@@ -19,6 +19,7 @@ pub const DEFAULT_COB_ID: u16 = cob::SYNC;
 
 /// A SYNC producer configuration CiA 301 does not allow.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum SyncConfigError {
     /// A counter overflow value outside 2..=240.
     CounterOverflow(u8),
@@ -206,6 +207,7 @@ impl Service for SyncProducer {
 
 /// What a [`SyncConsumer`] received.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum SyncEvent {
     /// A SYNC, with its counter when it carries one.
     Sync {

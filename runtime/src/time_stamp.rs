@@ -93,6 +93,7 @@ pub const ENCODED_LEN: usize = 6;
 
 /// Why a time could not be decoded or converted.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum TimeError {
     /// The data is not exactly 6 bytes long (the number it has).
     Length(usize),

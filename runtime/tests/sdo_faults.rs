@@ -212,6 +212,7 @@ fn run(s: &Scenario) -> Result<Outcome, String> {
                     Outcome::Done
                 }
                 ClientEvent::Failed { error, .. } => Outcome::Failed(error),
+                other => return Err(format!("unexpected client event {other:?}")),
             });
         }
         // Buffers stay within their bounds (a download's data is the client's

@@ -247,6 +247,7 @@ pub enum Action {
 
 /// Why a request failed (besides I/O, which is the caller's).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum OperationError {
     /// The device lacks an object the request needs; nothing was sent.
     Missing(MissingObject),

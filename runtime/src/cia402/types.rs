@@ -277,6 +277,7 @@ impl DriveConfig {
 
 /// What [`Drive`](super::Drive) reports.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum Event {
     /// The decoded state changed (`None`: no statusword yet, or a pattern
     /// outside the CiA 402 table).
@@ -329,6 +330,7 @@ pub enum Event {
 
 /// Why [`Drive`](super::Drive) refused a request.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum DriveError {
     /// The request needs Operation enabled.
     NotEnabled {

@@ -41,6 +41,7 @@ pub enum ConfigureService {
 /// The outcome of an [`LssMaster`] request; each request ends with exactly
 /// one event (unless cancelled).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum LssEvent {
     /// A request without response (switch state global, activate bit
     /// timing) was handed over by [`Service::poll_transmit`].

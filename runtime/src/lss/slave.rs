@@ -11,6 +11,7 @@ use crate::{Frame, Instant, Service};
 
 /// What an [`LssSlave`] tells the device (or simulator) around it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum LssSlaveEvent {
     /// The LSS state changed.
     StateChanged(LssState),

@@ -7,6 +7,7 @@ use crate::{Frame, Instant, Service};
 
 /// What an [`NmtSlave`] did.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum NmtSlaveEvent {
     /// The node's state changed.
     StateChanged {

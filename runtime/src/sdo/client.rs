@@ -129,6 +129,7 @@ pub struct Busy;
 
 /// The end of a transfer.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ClientEvent {
     /// An upload succeeded with this value.
     Uploaded {

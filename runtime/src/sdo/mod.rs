@@ -22,6 +22,7 @@ use crate::od::NodeId;
 
 /// How a transfer ended when it did not succeed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum SdoError {
     /// The peer aborted the transfer with this code.
     RemoteAbort(AbortCode),
@@ -85,6 +86,7 @@ pub struct Channel {
 
 /// Why an SDO parameter's COB-IDs name no channel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ChannelError {
     /// Bit 31 of this COB-ID is set: the SDO is not valid (not in use).
     NotValid(u32),

@@ -136,6 +136,7 @@ pub struct BlockSegment {
 
 /// Why a frame is not a valid SDO frame.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ParseError {
     /// Not 8 data bytes (or a remote frame).
     Length(usize),

@@ -95,6 +95,7 @@ impl ServerConfig {
 
 /// What the server did.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ServerEvent {
     /// A value was written to the store.
     Downloaded {

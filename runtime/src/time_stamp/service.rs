@@ -68,6 +68,7 @@ impl Default for TimeCobId {
 
 /// A TIME configuration that cannot be used.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum TimeConfigError {
     /// A value of object 0x1012 with an 11-bit identifier above 0x7FF.
     CobId(u32),
@@ -290,6 +291,7 @@ impl Service for TimeProducer {
 
 /// What a [`TimeConsumer`] received.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub enum TimeEvent {
     /// A valid TIME frame.
     Time {

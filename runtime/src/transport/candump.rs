@@ -166,6 +166,7 @@ impl std::error::Error for ParseError {}
 
 /// What a [`Reader`] can fail with.
 #[derive(Debug)]
+#[non_exhaustive]
 pub enum Error {
     /// Reading the input failed; the reader stops.
     Io(io::Error),

@@ -102,7 +102,7 @@ impl<B: Behaviour> Service for Device<B> {
                         .with_model(|b, ctx| b.heartbeat_resumed(ctx, node));
                     self.after_input(now);
                 }
-                HeartbeatEvent::State { .. } => {}
+                _ => {}
             }
         }
         self.events.pop_front()
