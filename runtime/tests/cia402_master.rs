@@ -292,10 +292,8 @@ fn missing_objects_are_refused_before_any_frame() {
     let mut rig = Rig::new(DeviceConfig::default(), false);
     thread::sleep(Duration::from_millis(20));
     rig.frames();
-    let config = SessionConfig {
-        required: &[Operation::ProfilePosition, Operation::ProfileVelocity],
-        ..SessionConfig::default()
-    };
+    let config = SessionConfig::default()
+        .with_required(&[Operation::ProfilePosition, Operation::ProfileVelocity]);
     let e = rig.master.drive(node(), &NO_VELOCITY, config).unwrap_err();
     assert_eq!(
         e.to_string(),
@@ -339,11 +337,9 @@ fn statuswords_from_a_tpdo_without_polling() {
         .pdo_rx
         .watch(u32::from(cob_id), 2, None)
         .unwrap();
-    let config = SessionConfig {
-        poll_period: None,
-        statusword_pdo: Some(StatuswordPdo { cob_id, offset: 0 }),
-        ..fast_config()
-    };
+    let config = fast_config()
+        .with_poll_period(None)
+        .with_statusword_pdo(StatuswordPdo { cob_id, offset: 0 });
     let mut drive = rig.master.drive(node(), &FULL, config).unwrap();
     drive.enable().unwrap();
     drive.move_to(40, Move::default()).unwrap();

@@ -112,8 +112,10 @@ pub struct StatuswordPdo {
     pub offset: usize,
 }
 
-/// How a [`Session`] runs.
+/// How a [`Session`] runs: [`SessionConfig::default`], then the `with_*`
+/// methods (or field assignments) for what differs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct SessionConfig {
     /// The helper's timeouts and fault-reset attempts.
     pub drive: DriveConfig,
@@ -138,6 +140,33 @@ impl Default for SessionConfig {
             statusword_pdo: None,
             required: &[],
         }
+    }
+}
+
+impl SessionConfig {
+    /// This configuration with the helper's timeouts and attempts `drive`.
+    pub const fn with_drive(mut self, drive: DriveConfig) -> SessionConfig {
+        self.drive = drive;
+        self
+    }
+
+    /// This configuration polling 0x6041 every `period` (`None`: only the
+    /// statusword TPDO).
+    pub const fn with_poll_period(mut self, period: Option<Duration>) -> SessionConfig {
+        self.poll_period = period;
+        self
+    }
+
+    /// This configuration taking the statusword from `pdo` too.
+    pub const fn with_statusword_pdo(mut self, pdo: StatuswordPdo) -> SessionConfig {
+        self.statusword_pdo = Some(pdo);
+        self
+    }
+
+    /// This configuration checking `operations` when the session is made.
+    pub const fn with_required(mut self, operations: &'static [Operation]) -> SessionConfig {
+        self.required = operations;
+        self
     }
 }
 

@@ -232,6 +232,7 @@ impl fmt::Display for Step {
 
 /// Configuration of a [`Drive`](super::Drive).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct DriveConfig {
     timeouts: [Duration; Step::COUNT],
     /// How many fault resets one operation tries before it gives up.

@@ -81,6 +81,7 @@ pub enum Method {
 
 /// Client settings.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct ClientConfig {
     /// The COB-IDs the client sends requests on and receives responses from.
     pub channel: Channel,

@@ -66,6 +66,7 @@ pub trait ObjectStore {
 
 /// Server settings.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct ServerConfig {
     /// The COB-IDs the server listens (request) and answers (response) on.
     pub channel: Channel,

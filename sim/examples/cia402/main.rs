@@ -195,11 +195,9 @@ pub fn check(table: &LoadedTable) -> Result<(), Failure> {
 
 /// The helper's configuration: profile position is checked up front.
 fn session_config() -> SessionConfig {
-    SessionConfig {
-        poll_period: Some(POLL),
-        required: &[Operation::ProfilePosition],
-        ..SessionConfig::default()
-    }
+    SessionConfig::default()
+        .with_poll_period(Some(POLL))
+        .with_required(&[Operation::ProfilePosition])
 }
 
 /// Runs the scenario on the file `args.file`, printing to `out`.

@@ -60,7 +60,7 @@ impl<B: Bus> Master<B> {
     /// # let core = master::Master::new(NodeId::new(1).unwrap(), Duration::from_millis(100));
     /// let mut m = Master::new(bus.attach(), core);
     /// let node = NodeId::new(0x20).unwrap();
-    /// let config = SessionConfig { required: &[Operation::ProfileVelocity], ..SessionConfig::default() };
+    /// let config = SessionConfig::default().with_required(&[Operation::ProfileVelocity]);
     /// let e = m.drive(node, &OBJECTS, config).err().unwrap();
     /// assert_eq!(
     ///     e.to_string(),
