@@ -119,6 +119,8 @@ pub fn transfer_error(
             timeout.as_millis(),
             node.get()
         ),
+        // The message names the node and the object already.
+        blocking::Error::Sdo { error, .. } => error.to_string(),
         other => other.to_string(),
     };
     LiveError::Failed(format!(
