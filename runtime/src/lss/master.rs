@@ -215,7 +215,7 @@ impl LssMaster {
     }
 
     /// Configure node id of the slave in the configuration state: a
-    /// [`NodeId`], or [`LssNodeId::Unconfigured`] (0xFF). Ends with
+    /// [`NodeId`](crate::od::NodeId), or [`LssNodeId::Unconfigured`] (0xFF). Ends with
     /// [`LssEvent::NodeIdConfigured`], [`LssEvent::ConfigureFailed`] or
     /// [`LssEvent::NoResponse`].
     pub fn configure_node_id(

@@ -117,7 +117,7 @@ impl<B: Bus> Master<B> {
     }
 
     /// Configures the node id of the slave in the configuration state (a
-    /// [`NodeId`], or [`LssNodeId::Unconfigured`]); it takes effect at its
+    /// [`NodeId`](crate::od::NodeId), or [`LssNodeId::Unconfigured`]); it takes effect at its
     /// next NMT reset communication.
     pub fn lss_configure_node_id(&mut self, node: impl Into<LssNodeId>) -> Result<(), Error> {
         let node = node.into();
