@@ -14,7 +14,7 @@
 //! frames are also fed to its PDO transmitters (a bus does not echo them),
 //! so synchronous RPDOs follow each SYNC.
 //!
-//! With `std`, [`crate::blocking::Master`] drives it on a bus and offers
+//! With `std`, [`crate::blocking::Master`] runs it on a bus and offers
 //! blocking SDO, NMT, PDO-configuration and LSS calls during which all the
 //! other cores keep running.
 //!
@@ -106,7 +106,7 @@ pub enum MasterEvent {
 /// Configure the cores through their fields (for example
 /// `master.consumer.monitor(node, time)`,
 /// `master.pdo_rx.watch(..)`, `master.sync = Some(..)`), then call
-/// [`Master::start`] and drive it as any [`Service`].
+/// [`Master::start`] and run it as any [`Service`].
 #[derive(Debug)]
 pub struct Master {
     /// Sends NMT commands and tracks the states nodes report.

@@ -8,7 +8,7 @@
 //!   the communication and mapping parameters in the table (reconfigurable
 //!   over SDO with the CiA 301 rules); EMCY; SYNC; and, when configured,
 //!   an LSS slave (CiA 305). It is a sans-IO [`Service`](eds2rust_runtime::Service)
-//!   like the runtime's cores, so tests drive it on a virtual clock and
+//!   like the runtime's cores, so tests run it on a virtual clock and
 //!   examples run it on a bus in a thread.
 //! - A [`Behaviour`] adds what the device does: `models` (feature
 //!   `seed-models`) has the three seed devices, written from their manuals.

@@ -32,7 +32,7 @@ use crate::{Instant, Service};
 /// Events [`Master`] keeps for [`Master::next_event`] by default.
 pub const MASTER_QUEUE_CAPACITY: usize = 1024;
 
-/// A composite CANopen master on a bus, driven on the calling thread.
+/// A composite CANopen master on a bus, run on the calling thread.
 ///
 /// Every blocking call (an SDO transfer, an LSS request, [`Master::run_for`],
 /// [`Master::run_until`]) runs all the cores while it waits: the master's
@@ -80,12 +80,12 @@ pub struct Master<B> {
 }
 
 impl<B: Bus> Master<B> {
-    /// Drives `core` on `bus`, with a clock starting now.
+    /// Runs `core` on `bus`, with a clock starting now.
     pub fn new(bus: B, core: master::Master) -> Master<B> {
         Master::with_clock(bus, core, Clock::new())
     }
 
-    /// Drives `core` on `bus`; the core sees time through `clock`.
+    /// Runs `core` on `bus`; the core sees time through `clock`.
     pub fn with_clock(bus: B, core: master::Master, clock: Clock) -> Master<B> {
         Master {
             bus,

@@ -340,7 +340,7 @@ impl<B: Bus> SdoClient<B> {
         self.upload_into(E::INDEX, E::SUBINDEX, writer, method, progress)
     }
 
-    /// Drives a started streamed transfer to its end; returns the upload
+    /// Runs a started streamed transfer to its end; returns the upload
     /// data the end event carried.
     fn run_stream<R: Read, W: Write, P: FnMut(Progress)>(
         &mut self,
