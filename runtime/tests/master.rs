@@ -17,6 +17,7 @@ use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtSlave, NmtState};
 use eds2rust_runtime::od::{AccessRight, DataType, Entry, NodeId, PdoDirection, access};
 use eds2rust_runtime::pdo::{PdoConfig, PdoEvent};
+use eds2rust_runtime::sdo::client::Method;
 use eds2rust_runtime::sdo::server::{MemoryStore, ObjectStore, SdoServer, ServerConfig};
 use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};
 use eds2rust_runtime::transport::Clock;
@@ -53,6 +54,17 @@ impl Entry for SlowValue {
     const PDO_MAPPABLE: bool = false;
     type Access = access::Ro;
     type Value = u32;
+}
+
+struct Blob;
+impl Entry for Blob {
+    const INDEX: u16 = 0x2100;
+    const SUBINDEX: u8 = 0;
+    const NAME: &'static str = "Blob";
+    const DATA_TYPE: DataType = DataType::Domain;
+    const PDO_MAPPABLE: bool = false;
+    type Access = access::Rw;
+    type Value = eds2rust_runtime::od::bytes::Domain;
 }
 
 /// A memory store whose object 0x2000:01 takes [`SLOW`] to read.
@@ -151,6 +163,7 @@ impl Rig {
             }
             store.insert_fixed(0x1A00, 0, AccessRight::Rw, &[0]);
             store.insert_fixed(0x1A00, 1, AccessRight::Rw, &[0; 4]);
+            store.insert(0x2100, 0, AccessRight::Rw, &[]);
             let id = node(DEVICE);
             let mut device = Device {
                 sdo: SdoServer::new(
@@ -444,4 +457,27 @@ fn configure_pdo_runs_the_steps_through_the_master() {
         e.to_string().starts_with("invalid PDO configuration"),
         "{e}"
     );
+}
+
+#[test]
+fn streamed_entries_go_through_the_master() {
+    let mut rig = Rig::new();
+    let data: Vec<u8> = (0..700u32).map(|i| (i * 13 % 251) as u8).collect();
+    let mut done = 0;
+    rig.master
+        .write_from::<Blob>(
+            node(DEVICE),
+            &mut data.as_slice(),
+            Some(700),
+            Method::Block,
+            |p| done = p.done,
+        )
+        .unwrap();
+    assert_eq!(done, 700);
+    let mut back = Vec::new();
+    let n = rig
+        .master
+        .read_into::<Blob>(node(DEVICE), &mut back, Method::Segmented, |_| {})
+        .unwrap();
+    assert_eq!((n, back), (700, data));
 }

@@ -13,10 +13,13 @@ use rig::*;
 use std::io::{self, Read};
 use std::time::Duration;
 
-use eds2rust_runtime::Frame;
 use eds2rust_runtime::blocking::Error;
-use eds2rust_runtime::sdo::client::{Method, Progress};
+use eds2rust_runtime::sdo::Channel;
+use eds2rust_runtime::sdo::client::{ClientConfig, Method, Progress};
+use eds2rust_runtime::tokio::SdoClient;
 use eds2rust_runtime::transport::AsyncBus;
+use eds2rust_runtime::transport::virtual_bus::VirtualBus;
+use eds2rust_runtime::{Frame, od};
 
 /// 3000 bytes, none alike in a row.
 fn data() -> Vec<u8> {
@@ -211,4 +214,100 @@ fn streamed_futures_are_send() {
     let mut writer = Vec::new();
     let upload = m.upload_into(node(2), 0x2100, 0, &mut writer, Method::Auto, |_| {});
     assert_send(&upload);
+}
+
+/// The COB-ID entry of TPDO1 (0x1800:01) as a one-element ARRAY, for the
+/// run-time element calls.
+struct Tpdo1CobId;
+
+impl od::Entry for Tpdo1CobId {
+    const INDEX: u16 = 0x1800;
+    const SUBINDEX: u8 = 1;
+    const NAME: &'static str = "TPDO1 COB-ID";
+    const DATA_TYPE: od::DataType = od::DataType::Unsigned32;
+    const PDO_MAPPABLE: bool = false;
+    type Access = od::access::Rw;
+    type Value = u32;
+}
+
+impl od::Array for Tpdo1CobId {
+    const FIRST: u8 = 1;
+    const LAST: u8 = 1;
+}
+
+/// The DOMAIN 0x2100:00 as a one-element ARRAY of bytes.
+struct Blobs;
+
+impl od::Entry for Blobs {
+    const INDEX: u16 = 0x2100;
+    const SUBINDEX: u8 = 0;
+    const NAME: &'static str = "Blobs";
+    const DATA_TYPE: od::DataType = od::DataType::Domain;
+    const PDO_MAPPABLE: bool = false;
+    type Access = od::access::Rw;
+    type Value = od::bytes::Domain;
+}
+
+impl od::Array for Blobs {
+    const FIRST: u8 = 0;
+    const LAST: u8 = 0;
+}
+
+#[tokio::test(start_paused = true)]
+async fn the_tokio_sdo_client_streams_and_takes_array_elements_as_the_master_does() {
+    let bus = VirtualBus::new();
+    let _device = spawn_device(bus.attach());
+    let config = ClientConfig::new(Channel::default_for(node(DEVICE)));
+    let mut client = SdoClient::new(bus.attach(), config);
+    for method in [Method::Segmented, Method::Block] {
+        let data = data();
+        let mut last = None;
+        client
+            .download_from(0x2100, 0, &mut data.as_slice(), Some(3000), method, |p| {
+                last = Some(p.done)
+            })
+            .await
+            .unwrap_or_else(|e| panic!("{method:?} download: {e}"));
+        assert_eq!(last, Some(3000), "{method:?}");
+        let mut back = Vec::new();
+        let n = client
+            .read_into::<Blob, _, _>(&mut back, method, |_| {})
+            .await
+            .unwrap_or_else(|e| panic!("{method:?} upload: {e}"));
+        assert_eq!((n, back), (3000, data), "{method:?}");
+    }
+    client
+        .write_from::<Blob, _, _>(&mut &b"abc"[..], None, Method::Segmented, |_| {})
+        .await
+        .unwrap();
+    let mut back = Vec::new();
+    client
+        .upload_into(0x2100, 0, &mut back, Method::Segmented, |_| {})
+        .await
+        .unwrap();
+    assert_eq!(back, b"abc");
+
+    let first = od::Element::<Tpdo1CobId>::new(1).unwrap();
+    assert_eq!(client.read_at(first).await.unwrap(), 0x1A0);
+    client.write_at(first, 0x1A1).await.unwrap();
+    assert_eq!(client.read_at(first).await.unwrap(), 0x1A1);
+    client.write_at(first, 0x1A0).await.unwrap();
+    let blob = od::Element::<Blobs>::new(0).unwrap();
+    client.write_bytes_at(blob, b"element").await.unwrap();
+    assert_eq!(client.read_bytes_at(blob).await.unwrap(), b"element");
+
+    // A failure names the node (the channel's), the object and the abort.
+    let e = client.upload(0x2001, 0).await.unwrap_err();
+    assert!(
+        matches!(
+            e,
+            Error::Sdo { node: Some(n), index: 0x2001, sub: 0, .. } if n == node(DEVICE)
+        ),
+        "{e:?}"
+    );
+    assert!(
+        e.to_string()
+            .starts_with("SDO transfer of 0x2001:0 with node 32: "),
+        "{e}"
+    );
 }
