@@ -2,6 +2,8 @@ use std::sync::Arc;
 use std::vec;
 
 use super::*;
+use crate::od::NodeId;
+use crate::sdo::{AbortCode, Channel, SdoError};
 use crate::transport::virtual_bus::VirtualBus;
 use crate::{CanId, Frame};
 
