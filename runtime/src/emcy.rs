@@ -25,6 +25,7 @@ pub struct Emcy {
 
 /// An EMCY frame without exactly 8 data bytes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct EmcyParseError {
     /// The number of data bytes found.
     pub len: usize,

@@ -246,6 +246,7 @@ pub enum Problem {
 /// An operation needs an object the device does not have (or not with the
 /// access right it needs).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[non_exhaustive]
 pub struct MissingObject {
     /// The operation.
     pub operation: Operation,

@@ -149,6 +149,7 @@ impl fmt::Display for Reason {
 
 /// A line that could not be read, with its 1-based number.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct ParseError {
     /// The 1-based line number.
     pub line: usize,

@@ -32,6 +32,7 @@ pub const DEFAULT_SEND_TIMEOUT: Duration = Duration::from_millis(100);
 
 /// An error a device reported, as carried inside an `io::Error`.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct DeviceError {
     /// The kind the device gave.
     pub kind: embedded_can::ErrorKind,

@@ -72,6 +72,7 @@ pub enum ErrorKind {
 
 /// A line that gave no frame, with its 1-based number.
 #[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct TraceError {
     /// The 1-based line number (for [`ErrorKind::Io`], the line being read).
     pub line: usize,
