@@ -122,6 +122,16 @@ impl fmt::Display for NmtState {
 /// ([`NmtTarget::All`]): an invalid node id never turns into one, since
 /// [`NodeId`] holds only 1 to 127 and [`NmtTarget::try_from`] a `u8`
 /// refuses 0 and 128 to 255.
+///
+/// ```
+/// use eds2rust_runtime::nmt::{NmtTarget, InvalidNodeId};
+/// use eds2rust_runtime::od::NodeId;
+///
+/// assert_eq!(NmtTarget::try_from(0x20).unwrap().to_byte(), 0x20);
+/// assert_eq!(NmtTarget::try_from(0), Err(InvalidNodeId(0)));
+/// assert_eq!(NodeId::new(0).map(NmtTarget::Node), None);
+/// assert_eq!(NmtTarget::All.to_byte(), 0);
+/// ```
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum NmtTarget {
     /// Every node: node id 0 on the bus.
@@ -139,9 +149,11 @@ impl NmtTarget {
         }
     }
 
-    /// The target a command frame's node byte names: 0 is every node, 1 to
-    /// 127 one node, anything else none (the frame is invalid).
-    pub const fn from_byte(byte: u8) -> Option<NmtTarget> {
+    /// The target a received command frame's node byte names: 0 is every
+    /// node, 1 to 127 one node, anything else none (the frame is invalid).
+    /// Not public: a number never becomes a broadcast outside frame
+    /// decoding ([`parse_command`]).
+    const fn from_byte(byte: u8) -> Option<NmtTarget> {
         match byte {
             0 => Some(NmtTarget::All),
             n => match NodeId::new(n) {
