@@ -7,9 +7,9 @@
 //!   with SDO, NMT, PDO configuration and LSS calls, and its events and
 //!   PDOs as streams ([`Events`], [`Pdos`]).
 //!
-//! Time comes from `tokio::time::Instant` (mapped through a [`Clock`]), so
-//! the drivers follow tokio's paused clock in tests. Deadlines are
-//! [`Deadline`]s: an [`Instant`] of the cores (`now(&clock) +
+//! Time comes from `tokio::time::Instant` (mapped through the [`Clock`]
+//! of [`clock`]), so the drivers follow tokio's paused clock in tests.
+//! Deadlines are [`Deadline`]s: an [`Instant`] of the cores (`clock.now() +
 //! Duration::from_millis(50)`), a `tokio::time::Instant` or
 //! [`Deadline::NEVER`].
 
@@ -36,15 +36,11 @@ pub use master::{
     PDO_QUEUE_CAPACITY, Pdos,
 };
 
-/// The cores' time now on `clock`, read from tokio's clock (the paused
-/// clock in tests); `clock.now()` would read the std clock instead.
-pub fn now(clock: &Clock) -> Instant {
-    clock.at(::tokio::time::Instant::now().into_std())
-}
-
-/// A clock whose origin is tokio's now (the paused clock in tests).
+/// A clock on tokio's clock whose origin is tokio's now: its
+/// [`Clock::now`] follows the paused clock in tests. The clock the tokio
+/// drivers make for themselves.
 pub fn clock() -> Clock {
-    Clock::starting_at(::tokio::time::Instant::now().into_std())
+    Clock::following_tokio()
 }
 
 /// Runs `service` on `bus` (see [`crate::blocking::drive`]): sends what it
@@ -53,7 +49,7 @@ pub fn clock() -> Clock {
 /// [`DriveError::Deadline`] once `deadline` passes first. Waits with
 /// `select!` on the bus and `tokio::time::sleep_until`.
 ///
-/// `deadline` is a point in time: an [`Instant`] of the cores (`now(clock)
+/// `deadline` is a point in time: an [`Instant`] of the cores (`clock.now()
 /// + Duration::from_millis(50)`), a `tokio::time::Instant` or
 /// [`Deadline::NEVER`] (see [`Deadline`]).
 pub async fn drive<B, S, T>(
@@ -131,7 +127,7 @@ where
                 return Ok(value);
             }
         }
-        let current = now(clock);
+        let current = clock.now();
         if deadline.is_some_and(|deadline| current >= deadline) {
             return Err(DriveError::Deadline);
         }
@@ -157,7 +153,7 @@ where
             () = &mut shutdown => return Err(DriveError::Stopped),
             received = bus.recv() => {
                 let frame = received.map_err(DriveError::Io)?;
-                service.handle_frame(now(clock), &frame);
+                service.handle_frame(clock.now(), &frame);
             }
             () = sleep => {}
         }
@@ -222,7 +218,7 @@ impl<B: AsyncBus> SdoClient<B> {
         sub: u8,
         transfer: Transfer<'_>,
     ) -> Result<Upload, Error> {
-        let start = now(&self.clock);
+        let start = self.clock.now();
         transfer.start(&mut self.core, start, index, sub)?;
         let deadline = start + transfer.bound(self.core.config());
         let until = |event| transfer_end(event, index, sub);
@@ -413,7 +409,7 @@ mod tests {
         let clock = clock();
         let mut core = ticker();
         let mut ticks = Vec::new();
-        let deadline = now(&clock) + Duration::from_millis(55);
+        let deadline = clock.now() + Duration::from_millis(55);
         let result = drive(
             &mut port,
             &clock,
@@ -429,11 +425,11 @@ mod tests {
         .await;
         assert!(matches!(result, Err(DriveError::Deadline)));
         // Paused time: the deadline is met exactly, after five ticks.
-        assert_eq!(now(&clock), deadline);
+        assert_eq!(clock.now(), deadline);
         assert_eq!(ticks.len(), 5);
 
         let mut seen = 0;
-        let deadline = now(&clock) + Duration::from_millis(30);
+        let deadline = clock.now() + Duration::from_millis(30);
         serve(
             &mut port,
             &clock,
@@ -444,7 +440,7 @@ mod tests {
         )
         .await
         .unwrap();
-        assert_eq!(now(&clock), deadline);
+        assert_eq!(clock.now(), deadline);
         // Ticks at 60, 70 and 80 ms.
         assert_eq!(seen, 3);
         // No deadline and a shutdown that has come: returns at once.
@@ -458,7 +454,7 @@ mod tests {
         )
         .await
         .unwrap();
-        assert_eq!(now(&clock), deadline);
+        assert_eq!(clock.now(), deadline);
     }
 
     #[::tokio::test(start_paused = true)]

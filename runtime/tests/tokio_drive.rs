@@ -45,11 +45,7 @@ impl Rig {
         let bus = VirtualBus::new();
         let monitor = bus.attach();
         let clock = driver::clock();
-        let sim = Arc::new(Mutex::new(Sim::with_now(
-            clock,
-            driver::now,
-            DeviceConfig::default(),
-        )));
+        let sim = Arc::new(Mutex::new(Sim::new(clock.clone(), DeviceConfig::default())));
         let shared = Arc::clone(&sim);
         let mut port = bus.attach();
         let device = tokio::spawn(async move {

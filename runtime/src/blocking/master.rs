@@ -325,7 +325,8 @@ impl<B: Bus> Master<B> {
             for limit in [deadline, timer].into_iter().flatten() {
                 wake = wake.min(limit);
             }
-            if let Some(frame) = self.bus.recv(wake - now).map_err(DriveError::Io)? {
+            let received = super::recv_until(&mut self.bus, &self.clock, now, wake);
+            if let Some(frame) = received.map_err(DriveError::Io)? {
                 self.core.handle_frame(self.clock.now(), &frame);
             }
         }
