@@ -6,6 +6,11 @@
 //! - [`SdoClient`] reads and writes objects of one node through
 //!   [`crate::sdo::client::SdoClient`]: raw bytes, or typed through the
 //!   generated [`od::Entry`] types.
+//!
+//! Time comes from the [`Clock`] each driver is given: the std clock by
+//! default, or a [`crate::transport::ManualClock`] in tests, on which the
+//! drivers never sleep (a wait with nothing on the bus moves the clock to
+//! its end instead).
 
 use core::fmt;
 use core::ops::ControlFlow;

@@ -133,8 +133,9 @@ impl Default for Clock {
 /// a timeout of one second takes no real time, and a peer must have its
 /// answer on the bus before the driver looks (a peer that answers from
 /// another thread may be too late: script such peers on the test's
-/// thread, or use the std clock). The tokio drivers take tokio's paused
-/// clock instead (`crate::tokio::clock`).
+/// thread, or use the std clock). Every blocking driver waiting on the
+/// clock moves it, so run one driver on it at a time. The tokio drivers
+/// take tokio's paused clock instead (`crate::tokio::clock`).
 ///
 /// ```
 /// use core::time::Duration;
