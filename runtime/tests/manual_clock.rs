@@ -1,17 +1,22 @@
 //! The blocking master on a manual clock: timers fire exactly when due and
 //! timeouts of any length take no real time; frames a peer has already sent
-//! are taken at the clock's time then.
+//! are taken at the clock's time then, and a peer behind the bus itself
+//! answers after a delay in the clock's time.
 
+use std::collections::VecDeque;
+use std::io;
 use std::ops::ControlFlow;
 use std::time::Duration;
 
 use eds2rust_runtime::blocking::Master;
 use eds2rust_runtime::heartbeat::HeartbeatEvent;
 use eds2rust_runtime::master::{self, MasterEvent};
-use eds2rust_runtime::od::{DataType, Entry, NodeId, access};
-use eds2rust_runtime::transport::ManualClock;
+use eds2rust_runtime::od::{AccessRight, DataType, Entry, NodeId, access};
+use eds2rust_runtime::sdo::Channel;
+use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
-use eds2rust_runtime::{CanId, Frame, Instant};
+use eds2rust_runtime::transport::{Bus, Clock, ManualClock};
+use eds2rust_runtime::{CanId, Frame, Instant, Service};
 
 /// The master's heartbeat period.
 const PERIOD: Duration = Duration::from_millis(20);
@@ -101,4 +106,75 @@ fn a_silent_node_fails_an_sdo_read_after_its_timeout_in_no_real_time() {
         .filter(|f| f.starts_with("605#"))
         .collect();
     assert_eq!(sent, ["605#4000100000000000", "605#8000100000000405"]);
+}
+
+/// The other end of the master's bus: an SDO server (node 0x20) that
+/// answers each request `delay` after it came, in the manual clock's time,
+/// and a log of every frame the master sent with when it was sent.
+struct SlowServer {
+    clock: Clock,
+    server: SdoServer<MemoryStore>,
+    delay: Duration,
+    answers: VecDeque<(Instant, Frame)>,
+    sent: Vec<(Instant, Frame)>,
+}
+
+impl Bus for SlowServer {
+    fn send(&mut self, frame: &Frame) -> io::Result<()> {
+        let now = self.clock.now();
+        self.sent.push((now, *frame));
+        self.server.handle_frame(now, frame);
+        while let Some(answer) = self.server.poll_transmit() {
+            self.answers.push_back((now + self.delay, answer));
+        }
+        Ok(())
+    }
+
+    fn recv(&mut self, _timeout: Duration) -> io::Result<Option<Frame>> {
+        let due = self
+            .answers
+            .front()
+            .is_some_and(|(at, _)| *at <= self.clock.now());
+        Ok(due
+            .then(|| self.answers.pop_front().map(|(_, f)| f))
+            .flatten())
+    }
+}
+
+#[test]
+fn the_heartbeat_keeps_its_period_during_a_slow_sdo_read() {
+    let time = ManualClock::new();
+    let mut store = MemoryStore::new();
+    store.insert_fixed(0x1000, 0, AccessRight::Ro, &0x0002_0192u32.to_le_bytes());
+    let bus = SlowServer {
+        clock: time.clock(),
+        server: SdoServer::new(ServerConfig::new(Channel::default_for(node(DEVICE))), store),
+        delay: Duration::from_millis(300),
+        answers: VecDeque::new(),
+        sent: Vec::new(),
+    };
+    let core = master::Master::new(node(1), PERIOD);
+    let mut m = Master::with_clock(bus, core, time.clock());
+    m.start().unwrap();
+    assert_eq!(m.read::<DeviceType>(node(DEVICE)).unwrap(), 0x0002_0192);
+    // The answer came 300 ms after the request, which went out at once.
+    assert_eq!(time.now(), Instant::from_millis(300));
+    let sent = &m.bus().sent;
+    assert_eq!(sent[0], (Instant::ZERO, frame(0x701, &[0x00])));
+    assert_eq!(sent[1].0, Instant::ZERO);
+    assert_eq!(sent[1].1.cob_id(), Some(0x620));
+    // Meanwhile every heartbeat went out exactly on time.
+    let beats: Vec<Instant> = sent[2..]
+        .iter()
+        .map(|(at, f)| {
+            assert_eq!(*f, frame(0x701, &[0x7F]));
+            *at
+        })
+        .collect();
+    let due: Vec<Instant> = (1..=15).map(|n| Instant::from_millis(20 * n)).collect();
+    assert_eq!(beats, due);
+}
+
+fn frame(id: u16, data: &[u8]) -> Frame {
+    Frame::new(CanId::Standard(id), data).unwrap()
 }
