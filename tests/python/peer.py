@@ -386,8 +386,9 @@ class Peer:
         return {}
 
     def op_tpdo_wait(self, cmd):
-        """Waits for a reception of TPDO `number` since its last tpdo_arm and
-        returns its data and every variable's decoded raw value."""
+        """Waits for a reception of TPDO `number` since its last tpdo_arm (any
+        reception so far, if it was never armed) and returns the data of the
+        latest and every variable's decoded raw value."""
         pdo_map = self.remote_node(cmd["node"]).tpdo.map[cmd["number"]]
         with pdo_map.receive_condition:
             pdo_map.receive_condition.wait_for(
