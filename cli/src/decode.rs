@@ -9,7 +9,7 @@ use std::sync::Arc;
 
 use clap::{Args, ValueEnum};
 use eds2rust::input::Options;
-use eds2rust_decode::{Decoder, Record, render};
+use eds2rust_decode::{Decoder, Record, TraceDecodeError, render};
 
 /// Output forms.
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -144,7 +144,11 @@ pub fn run(args: DecodeArgs) -> ExitCode {
     let result = eds2rust_decode::decode_trace(&mut decoder, input, |r| {
         write_record(&mut out, args.format, r)
     });
-    let result = result.and_then(|summary| out.flush().map(|()| summary));
+    let result = result.and_then(|summary| {
+        out.flush()
+            .map(|()| summary)
+            .map_err(TraceDecodeError::Sink)
+    });
     match result {
         Ok(summary) => {
             if summary.bad_lines > 0 {
@@ -158,7 +162,9 @@ pub fn run(args: DecodeArgs) -> ExitCode {
             ExitCode::SUCCESS
         }
         // `eds2rust decode trace.log | head`: the reader left; not an error.
-        Err(e) if e.kind() == io::ErrorKind::BrokenPipe => ExitCode::SUCCESS,
+        Err(TraceDecodeError::Sink(e)) if e.kind() == io::ErrorKind::BrokenPipe => {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             let _ = writeln!(io::stderr(), "error: {e}");
             ExitCode::from(1)

@@ -209,7 +209,7 @@ pub fn simulate(
         od: od.as_ref(),
         node,
         bus,
-        clock,
+        clock: clock.clone(),
         stop,
         out,
         err,

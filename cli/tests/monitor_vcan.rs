@@ -52,6 +52,18 @@ fn expect_frame(bus: &mut SocketCanBus, id: u16, first: u8, what: &str) {
     panic!("no {what} (0x{id:03X} [{first:02X} ..]) within 5 s");
 }
 
+/// Waits up to 5 s for a frame with `id` on `bus`.
+fn expect_id(bus: &mut SocketCanBus, id: u16, what: &str) {
+    let deadline = std::time::Instant::now() + Duration::from_secs(5);
+    while std::time::Instant::now() < deadline {
+        let got = bus.recv(Duration::from_millis(100)).unwrap();
+        if got.is_some_and(|f| f.id() == CanId::Standard(id)) {
+            return;
+        }
+    }
+    panic!("no {what} (0x{id:03X}) within 5 s");
+}
+
 #[test]
 fn an_interface_that_cannot_be_opened_is_named_with_what_to_do_and_the_os_error() {
     let err = fails(1, &["monitor", "-i", "nosuchcan0", "--duration", "1"]);
@@ -266,7 +278,10 @@ fn monitor_streams_tables_and_plots_the_linak_actuator() {
     for m in [&mut json, &mut table, &mut plot] {
         m.assert_running();
     }
-    std::thread::sleep(Duration::from_millis(2500));
+    // Ten TPDO1s (2.5 s at the event timer) for the monitors to record.
+    for n in 0..10 {
+        expect_id(&mut master, 0x1A0, &format!("TPDO1 number {}", n + 1));
+    }
     json.assert_running();
     table.assert_running();
 

@@ -14,8 +14,10 @@
 //! `eds2rust decode` (recorded traces) and `eds2rust monitor` (a live bus)
 //! are this crate behind a command line; docs/decode.md describes both.
 
+mod decoded;
 pub mod decoder;
 pub mod dictionary;
+pub mod error;
 pub mod pdo;
 pub mod record;
 pub mod render;
@@ -23,6 +25,7 @@ pub mod sdo;
 pub mod value;
 
 pub use decoder::Decoder;
+pub use error::{TraceDecodeError, UnknownType, ValueError};
 pub use record::{FrameRecord, Kind, Protocol, Record, TransferRecord};
 
 use std::io::{self, BufRead};
@@ -44,13 +47,14 @@ pub struct Summary {
 /// Decodes a recorded trace in any form the runtime's trace reader knows
 /// (candump log, text and compact lines; PCAN-View `.trc` files), handing
 /// every record to `sink` in order. Bad lines become diagnostics and
-/// decoding goes on; only a failure to read `input` or an error of `sink`
-/// ends it.
+/// decoding goes on; only a failure to read `input`
+/// ([`TraceDecodeError::Read`]) or an error of `sink`
+/// ([`TraceDecodeError::Sink`]) ends it.
 pub fn decode_trace<R: BufRead>(
     decoder: &mut Decoder,
     input: R,
     mut sink: impl FnMut(&Record) -> io::Result<()>,
-) -> io::Result<Summary> {
+) -> Result<Summary, TraceDecodeError> {
     let mut summary = Summary::default();
     let mut records = Vec::new();
     for item in Reader::new(input) {
@@ -60,10 +64,10 @@ pub fn decode_trace<R: BufRead>(
                 let time = line.time.map(|t| t.as_secs_f64());
                 decoder.frame(line.line, time, &line.frame, &mut records);
                 for r in records.drain(..) {
-                    sink(&r)?;
+                    sink(&r).map_err(TraceDecodeError::Sink)?;
                 }
             }
-            Err(e) if e.kind == ErrorKind::Io => return Err(io::Error::other(e.to_string())),
+            Err(e) if e.kind == ErrorKind::Io => return Err(TraceDecodeError::Read(e)),
             Err(e) => {
                 match e.kind {
                     ErrorKind::Skipped => summary.skipped += 1,
@@ -72,7 +76,8 @@ pub fn decode_trace<R: BufRead>(
                 sink(&Record::Diagnostic {
                     line: e.line,
                     message: e.message,
-                })?;
+                })
+                .map_err(TraceDecodeError::Sink)?;
             }
         }
     }

@@ -10,6 +10,7 @@ use eds2rust_runtime::lss::proto as lss;
 use eds2rust_runtime::nmt::NmtCommand;
 use eds2rust_runtime::time_stamp::{TimeError, TimeOfDay};
 
+use crate::error::ValueError;
 use crate::pdo::{PdoLayout, Raw};
 use crate::sdo::{Role, SdoFrame, Transfer};
 use crate::value::Decoded;
@@ -153,7 +154,7 @@ pub struct TransferValue {
     pub data_type: DataType,
     pub semantics: Arc<Semantics>,
     /// The value, or why the data is no value of the type.
-    pub value: Result<Decoded, String>,
+    pub value: Result<Decoded, ValueError>,
 }
 
 /// An SDO transfer that ended (done or aborted).

@@ -9,18 +9,8 @@ use std::fmt::Write as _;
 
 use eds2rust::ir::{BitField, DataType, Semantics, Value, ValueKind, ValueTable};
 
-/// Longest byte string printed whole; longer ones are cut with their length.
-const BYTES_SHOWN: usize = 64;
-
-/// A decoded value.
-#[derive(Debug, Clone, PartialEq)]
-pub enum Decoded {
-    /// Integers, BOOLEAN (0/1) and the TIME types (their raw 48 bits).
-    Int(i128),
-    Real(f64),
-    Text(String),
-    Bytes(Vec<u8>),
-}
+pub use crate::decoded::{Decoded, hex_bytes};
+use crate::error::{UnknownType, ValueError};
 
 /// The size in bytes of a fixed-size type; `None` for strings and domains.
 pub fn fixed_size(t: DataType) -> Option<usize> {
@@ -34,7 +24,7 @@ pub fn fixed_size(t: DataType) -> Option<usize> {
 /// The value of `data` as `t`, and a note when the device sent more bytes
 /// than the type has (their leading bytes are taken, as the runtime's typed
 /// reads do).
-pub fn decode(t: DataType, data: &[u8]) -> Result<(Decoded, Option<String>), String> {
+pub fn decode(t: DataType, data: &[u8]) -> Result<(Decoded, Option<String>), ValueError> {
     let Some(kind) = t.value_kind() else {
         return Ok((Decoded::Bytes(data.to_vec()), None));
     };
@@ -42,12 +32,11 @@ pub fn decode(t: DataType, data: &[u8]) -> Result<(Decoded, Option<String>), Str
     let fixed = match fixed_size(t) {
         Some(size) => {
             if data.len() < size {
-                return Err(format!(
-                    "{} bytes ({}) cannot be a {} ({size} bytes)",
-                    data.len(),
-                    hex_bytes(data),
-                    t.name()
-                ));
+                return Err(ValueError::TooShort {
+                    data_type: t,
+                    data: data.to_vec(),
+                    size,
+                });
             }
             if data.len() > size {
                 note = Some(format!(
@@ -59,6 +48,11 @@ pub fn decode(t: DataType, data: &[u8]) -> Result<(Decoded, Option<String>), Str
             &data[..size]
         }
         None => data,
+    };
+    let too_short = || ValueError::TooShort {
+        data_type: t,
+        data: data.to_vec(),
+        size: fixed.len(),
     };
     let value = match kind {
         ValueKind::Integer { signed, bits } => {
@@ -73,16 +67,16 @@ pub fn decode(t: DataType, data: &[u8]) -> Result<(Decoded, Option<String>), Str
                 raw as i128
             };
             if t == DataType::Boolean && v > 1 {
-                return Err(format!("{v:#04X} is not a BOOLEAN (0 or 1)"));
+                return Err(ValueError::NotBoolean { raw: v });
             }
             Decoded::Int(v)
         }
         ValueKind::Real { bits: 32 } => {
-            let b: [u8; 4] = fixed.try_into().map_err(|_| "REAL32 needs 4 bytes")?;
+            let b: [u8; 4] = fixed.try_into().map_err(|_| too_short())?;
             Decoded::Real(f64::from(f32::from_le_bytes(b)))
         }
         ValueKind::Real { .. } => {
-            let b: [u8; 8] = fixed.try_into().map_err(|_| "REAL64 needs 8 bytes")?;
+            let b: [u8; 8] = fixed.try_into().map_err(|_| too_short())?;
             Decoded::Real(f64::from_le_bytes(b))
         }
         ValueKind::Text if t == DataType::UnicodeString => {
@@ -103,18 +97,20 @@ pub fn decode(t: DataType, data: &[u8]) -> Result<(Decoded, Option<String>), Str
 }
 
 /// The bytes of `value` as `t` (little endian, two's complement).
-pub fn encode(t: DataType, value: &Decoded) -> Result<Vec<u8>, String> {
+pub fn encode(t: DataType, value: &Decoded) -> Result<Vec<u8>, ValueError> {
     let kind = t
         .value_kind()
-        .ok_or_else(|| format!("data type {:#06X} is not a basic type", t.code()))?;
+        .ok_or(ValueError::NotBasic { data_type: t })?;
     match (kind, value) {
         (ValueKind::Integer { .. }, Decoded::Int(v)) => {
             let (low, high) = t.integer_range().unwrap_or((i128::MIN, i128::MAX));
             if *v < low || *v > high {
-                return Err(format!(
-                    "{v} is outside the range of {} ({low} to {high})",
-                    t.name()
-                ));
+                return Err(ValueError::OutOfRange {
+                    data_type: t,
+                    value: *v,
+                    low,
+                    high,
+                });
             }
             let size = fixed_size(t).unwrap_or(8);
             Ok((0..size).map(|i| (*v >> (8 * i)) as u8).collect())
@@ -127,15 +123,16 @@ pub fn encode(t: DataType, value: &Decoded) -> Result<Vec<u8>, String> {
             Ok(s.encode_utf16().flat_map(u16::to_le_bytes).collect())
         }
         (ValueKind::Text, Decoded::Text(s)) => {
-            if let Some(c) = s.chars().find(|c| !(' '..='~').contains(c)) {
-                return Err(format!(
-                    "{c:?} is not a visible character (a VISIBLE_STRING holds 0x20 to 0x7E)"
-                ));
+            if let Some(character) = s.chars().find(|c| !(' '..='~').contains(c)) {
+                return Err(ValueError::NotVisible { character });
             }
             Ok(s.as_bytes().to_vec())
         }
         (ValueKind::Bytes, Decoded::Bytes(b)) => Ok(b.clone()),
-        (_, other) => Err(format!("{other:?} is not a value of {}", t.name())),
+        (_, other) => Err(ValueError::WrongKind {
+            data_type: t,
+            value: other.clone(),
+        }),
     }
 }
 
@@ -157,22 +154,6 @@ pub fn from_ir(value: &Value) -> Decoded {
         Value::Text(s) => Decoded::Text(s.clone()),
         Value::Bytes(b) => Decoded::Bytes(b.clone()),
     }
-}
-
-/// Bytes in hex, space-separated (`01 0A FF`); `(empty)` for none.
-pub fn hex_bytes(data: &[u8]) -> String {
-    if data.is_empty() {
-        return "(empty)".into();
-    }
-    let mut s = String::new();
-    for (i, b) in data.iter().take(BYTES_SHOWN).enumerate() {
-        let sep = if i == 0 { "" } else { " " };
-        let _ = write!(s, "{sep}{b:02X}");
-    }
-    if data.len() > BYTES_SHOWN {
-        let _ = write!(s, " ... ({} bytes)", data.len());
-    }
-    s
 }
 
 /// The bare value, for scripts (`--quiet`): integers in decimal, reals as
@@ -349,16 +330,16 @@ fn field_text(f: &BitField, raw: u64) -> Option<String> {
 /// physical value with the entry's unit (`12.5 mm`, `12.5mm`); booleans as
 /// `true`/`false`/`1`/`0`; reals; text as it is; byte strings as hex
 /// (`010AFF`, `01 0A FF`, `0x010AFF`).
-pub fn parse(t: DataType, semantics: &Semantics, text: &str) -> Result<Decoded, String> {
+pub fn parse(t: DataType, semantics: &Semantics, text: &str) -> Result<Decoded, ValueError> {
     let kind = t
         .value_kind()
-        .ok_or_else(|| format!("data type {:#06X} is not a basic type", t.code()))?;
+        .ok_or(ValueError::NotBasic { data_type: t })?;
     let trimmed = text.trim();
     match kind {
         ValueKind::Integer { bits: 1, .. } => match trimmed.to_ascii_lowercase().as_str() {
             "true" | "1" | "on" => Ok(Decoded::Int(1)),
             "false" | "0" | "off" => Ok(Decoded::Int(0)),
-            _ => Err(format!("`{text}` is not a BOOLEAN (true, false, 1 or 0)")),
+            _ => Err(ValueError::NotBooleanText { text: text.into() }),
         },
         ValueKind::Integer { .. } => parse_int_value(t, semantics, trimmed).map(Decoded::Int),
         ValueKind::Real { .. } => {
@@ -366,7 +347,7 @@ pub fn parse(t: DataType, semantics: &Semantics, text: &str) -> Result<Decoded, 
             number
                 .parse::<f64>()
                 .map(Decoded::Real)
-                .map_err(|_| format!("`{text}` is not a number"))
+                .map_err(|_| ValueError::NotNumber { text: text.into() })
         }
         ValueKind::Text => Ok(Decoded::Text(text.to_string())),
         ValueKind::Bytes => parse_hex(trimmed).map(Decoded::Bytes),
@@ -380,7 +361,7 @@ fn strip_unit<'a>(text: &'a str, unit: Option<&str>) -> &'a str {
     }
 }
 
-fn parse_int_value(t: DataType, sem: &Semantics, text: &str) -> Result<i128, String> {
+fn parse_int_value(t: DataType, sem: &Semantics, text: &str) -> Result<i128, ValueError> {
     if let Some(v) = parse_int(text) {
         return Ok(v);
     }
@@ -399,28 +380,28 @@ fn parse_int_value(t: DataType, sem: &Semantics, text: &str) -> Result<i128, Str
             let raw = (x - sem.offset.unwrap_or(0.0)) / sem.scale.unwrap_or(1.0);
             let rounded = raw.round();
             if (raw - rounded).abs() > 1e-6 * rounded.abs().max(1.0) {
-                return Err(format!(
-                    "{text} is not a whole number of steps of {} {}",
-                    sem.scale.unwrap_or(1.0),
-                    sem.unit.as_deref().unwrap_or("")
-                ));
+                return Err(ValueError::NotWholeSteps {
+                    text: text.into(),
+                    scale: sem.scale.unwrap_or(1.0),
+                    unit: sem.unit.clone(),
+                });
             }
             return Ok(rounded as i128);
         }
     }
-    let mut message = format!("`{text}` is not valid for {}", t.name());
-    if let Some(table) = &sem.values {
-        let names: Vec<String> = table
+    let names = sem.values.as_ref().map_or_else(Vec::new, |table| {
+        table
             .named
             .iter()
             .filter(|n| !n.is_range())
             .map(|n| format!("{:?}", n.name))
-            .collect();
-        if !names.is_empty() {
-            let _ = write!(message, " (a number or one of {})", names.join(", "));
-        }
-    }
-    Err(message)
+            .collect()
+    });
+    Err(ValueError::NotInteger {
+        text: text.into(),
+        data_type: t,
+        names,
+    })
 }
 
 /// An integer in decimal (optionally negative) or `0x` hex; `_` allowed.
@@ -441,7 +422,7 @@ pub fn parse_int(text: &str) -> Option<i128> {
 }
 
 /// Hex bytes: `010AFF`, `01 0A FF`, `01:0a:ff` or `0x010AFF`; empty is none.
-pub fn parse_hex(text: &str) -> Result<Vec<u8>, String> {
+pub fn parse_hex(text: &str) -> Result<Vec<u8>, ValueError> {
     let body = text
         .strip_prefix("0x")
         .or_else(|| text.strip_prefix("0X"))
@@ -451,9 +432,7 @@ pub fn parse_hex(text: &str) -> Result<Vec<u8>, String> {
         .filter(|c| !matches!(c, ' ' | ':' | '-' | '_'))
         .collect();
     if !digits.len().is_multiple_of(2) || !digits.bytes().all(|b| b.is_ascii_hexdigit()) {
-        return Err(format!(
-            "`{text}` is not hex bytes (two hex digits a byte, e.g. 010AFF or \"01 0A FF\")"
-        ));
+        return Err(ValueError::NotHex { text: text.into() });
     }
     Ok((0..digits.len() / 2)
         .map(|i| u8::from_str_radix(&digits[2 * i..2 * i + 2], 16).unwrap_or(0))
@@ -463,7 +442,7 @@ pub fn parse_hex(text: &str) -> Result<Vec<u8>, String> {
 /// The data type a `--type` name stands for: `u8`..`u64`, `i8`..`i64`,
 /// `bool`, `f32`, `f64`, `str`, `unicode`, `bytes`, `domain`, or a CiA 301
 /// name (`UNSIGNED16`).
-pub fn parse_type(name: &str) -> Result<DataType, String> {
+pub fn parse_type(name: &str) -> Result<DataType, UnknownType> {
     use DataType::*;
     let t = match name.to_ascii_lowercase().as_str() {
         "bool" | "boolean" => Boolean,
@@ -490,104 +469,11 @@ pub fn parse_type(name: &str) -> Result<DataType, String> {
         "bytes" | "octet_string" => OctetString,
         "domain" => Domain,
         _ => {
-            return Err(format!(
-                "`{name}` is not a type: u8 u16 u24 u32 u40 u48 u56 u64, i8 .. i64, bool, \
-                 f32, f64, str, unicode, bytes, domain"
-            ));
+            return Err(UnknownType { name: name.into() });
         }
     };
     Ok(t)
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-    use eds2rust::ir::{NamedValue, Origin};
-
-    #[test]
-    fn integers_round_trip_by_type() {
-        for (t, v) in [
-            (DataType::Unsigned8, 200),
-            (DataType::Integer8, -5),
-            (DataType::Integer24, -0x7F_FFFF),
-            (DataType::Unsigned64, u64::MAX as i128),
-            (DataType::Integer64, i64::MIN as i128),
-            (DataType::Boolean, 1),
-        ] {
-            let bytes = encode(t, &Decoded::Int(v)).unwrap();
-            assert_eq!(bytes.len(), fixed_size(t).unwrap());
-            assert_eq!(decode(t, &bytes).unwrap(), (Decoded::Int(v), None), "{t:?}");
-        }
-        assert!(encode(DataType::Unsigned8, &Decoded::Int(256)).is_err());
-        assert!(encode(DataType::Integer8, &Decoded::Int(-129)).is_err());
-        let (v, note) = decode(DataType::Unsigned8, &[7, 0, 0, 0]).unwrap();
-        assert_eq!(v, Decoded::Int(7));
-        assert!(note.unwrap().contains("4 bytes"));
-        assert!(decode(DataType::Unsigned16, &[7]).is_err());
-    }
-
-    #[test]
-    fn parse_and_describe_with_semantics() {
-        let origin = Origin::default();
-        let sem = Semantics {
-            unit: Some("mm".into()),
-            scale: Some(0.1),
-            values: Some(ValueTable {
-                numeric: Some((0, 0xFAFF)),
-                named: vec![NamedValue {
-                    low: 0xFB00,
-                    high: 0xFB00,
-                    name: "clear error".into(),
-                    text: None,
-                    rust_name: None,
-                    origin,
-                }],
-                other: "invalid".into(),
-            }),
-            ..Semantics::default()
-        };
-        let t = DataType::Unsigned16;
-        assert_eq!(parse(t, &sem, "12.5 mm").unwrap(), Decoded::Int(125));
-        assert_eq!(parse(t, &sem, "12.5mm").unwrap(), Decoded::Int(125));
-        assert_eq!(parse(t, &sem, "0x7D").unwrap(), Decoded::Int(125));
-        assert_eq!(parse(t, &sem, "Clear Error").unwrap(), Decoded::Int(0xFB00));
-        assert!(parse(t, &sem, "12.55 mm").is_err());
-        assert_eq!(
-            describe(t, &sem, &Decoded::Int(125)),
-            "125 (0x007D) = 12.5 mm"
-        );
-        assert_eq!(
-            describe(t, &sem, &Decoded::Int(0xFB00)),
-            "64256 (0xFB00) \"clear error\""
-        );
-        assert_eq!(
-            describe(t, &sem, &Decoded::Int(0xFC00)),
-            "64512 (0xFC00) \"invalid\""
-        );
-    }
-
-    #[test]
-    fn strings_bytes_and_types() {
-        let none = Semantics::default();
-        assert_eq!(
-            parse(DataType::OctetString, &none, "01 0a FF").unwrap(),
-            Decoded::Bytes(vec![1, 10, 255])
-        );
-        assert!(parse_hex("0").is_err());
-        assert_eq!(
-            decode(DataType::VisibleString, b"ab\0\0").unwrap().0,
-            Decoded::Text("ab".into())
-        );
-        assert!(encode(DataType::VisibleString, &Decoded::Text("é".into())).is_err());
-        assert_eq!(parse_type("U16").unwrap(), DataType::Unsigned16);
-        assert_eq!(parse_type("UNSIGNED16").unwrap(), DataType::Unsigned16);
-        assert!(parse_type("u12").is_err());
-        assert_eq!(parse_int("-0x10"), Some(-16));
-        assert_eq!(parse_int("1_000"), Some(1000));
-        assert_eq!(parse_int("abc"), None);
-        assert_eq!(
-            describe(DataType::Real32, &none, &Decoded::Real(f64::from(0.1f32))),
-            "0.1"
-        );
-    }
-}
+mod tests;

@@ -6,6 +6,11 @@
 //! - [`SdoClient`] reads and writes objects of one node through
 //!   [`crate::sdo::client::SdoClient`]: raw bytes, or typed through the
 //!   generated [`od::Entry`] types.
+//!
+//! Time comes from the [`Clock`] each driver is given: the std clock by
+//! default, or a [`crate::transport::ManualClock`] in tests, on which the
+//! drivers never sleep (a wait with nothing on the bus moves the clock to
+//! its end instead).
 
 use core::fmt;
 use core::ops::ControlFlow;
@@ -21,7 +26,7 @@ use crate::sdo::client::{self, ClientConfig, Method};
 use crate::sdo::typed::{self, LengthNote};
 pub use crate::time::Deadline;
 use crate::transport::{Bus, Clock};
-use crate::{Instant, Service};
+use crate::{Frame, Instant, Service};
 
 mod error;
 pub(crate) mod master;
@@ -190,10 +195,32 @@ where
         if stop.is_some() {
             wake = wake.min(now + STOP_POLL);
         }
-        if let Some(frame) = bus.recv(wake - now).map_err(RunError::Io)? {
+        if let Some(frame) = recv_until(bus, clock, now, wake).map_err(RunError::Io)? {
             service.handle_frame(clock.now(), &frame);
         }
     }
+}
+
+/// Waits on `bus` for the next frame until `wake` (`now` is the time last
+/// read from `clock`); `Ok(None)` when none came. On a manual clock it
+/// never waits: it takes a frame already there, or else moves the clock to
+/// `wake` (see [`crate::transport::ManualClock`]).
+pub(crate) fn recv_until<B: Bus + ?Sized>(
+    bus: &mut B,
+    clock: &Clock,
+    now: Instant,
+    wake: Instant,
+) -> io::Result<Option<Frame>> {
+    if !clock.is_manual() {
+        return bus.recv(wake - now);
+    }
+    let frame = bus.recv(Duration::ZERO)?;
+    if frame.is_none() {
+        clock.skip_to(wake);
+        // Lets a peer on another thread run before the next look.
+        std::thread::yield_now();
+    }
+    Ok(frame)
 }
 
 pub use error::Error;

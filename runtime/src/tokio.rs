@@ -7,9 +7,9 @@
 //!   with SDO, NMT, PDO configuration and LSS calls, and its events and
 //!   PDOs as streams ([`Events`], [`Pdos`]).
 //!
-//! Time comes from `tokio::time::Instant` (mapped through a [`Clock`]), so
-//! the drivers follow tokio's paused clock in tests. Deadlines are
-//! [`Deadline`]s: an [`Instant`] of the cores (`now(&clock) +
+//! Time comes from `tokio::time::Instant` (mapped through the [`Clock`]
+//! of [`clock`]), so the drivers follow tokio's paused clock in tests.
+//! Deadlines are [`Deadline`]s: an [`Instant`] of the cores (`clock.now() +
 //! Duration::from_millis(50)`), a `tokio::time::Instant` or
 //! [`Deadline::NEVER`].
 
@@ -36,15 +36,11 @@ pub use master::{
     PDO_QUEUE_CAPACITY, Pdos,
 };
 
-/// The cores' time now on `clock`, read from tokio's clock (the paused
-/// clock in tests); `clock.now()` would read the std clock instead.
-pub fn now(clock: &Clock) -> Instant {
-    clock.at(::tokio::time::Instant::now().into_std())
-}
-
-/// A clock whose origin is tokio's now (the paused clock in tests).
+/// A clock on tokio's clock whose origin is tokio's now: its
+/// [`Clock::now`] follows the paused clock in tests. The clock the tokio
+/// drivers make for themselves.
 pub fn clock() -> Clock {
-    Clock::starting_at(::tokio::time::Instant::now().into_std())
+    Clock::following_tokio()
 }
 
 /// Runs `service` on `bus` (see [`crate::blocking::run`]): sends what it
@@ -53,7 +49,7 @@ pub fn clock() -> Clock {
 /// [`RunError::Deadline`] once `deadline` passes first. Waits with
 /// `select!` on the bus and `tokio::time::sleep_until`.
 ///
-/// `deadline` is a point in time: an [`Instant`] of the cores (`now(clock)
+/// `deadline` is a point in time: an [`Instant`] of the cores (`clock.now()
 /// + Duration::from_millis(50)`), a `tokio::time::Instant` or
 /// [`Deadline::NEVER`] (see [`Deadline`]).
 pub async fn run<B, S, T>(
@@ -140,7 +136,7 @@ where
 {
     let mut shutdown = pin!(shutdown);
     loop {
-        if hook(service, now(clock)).is_break() {
+        if hook(service, clock.now()).is_break() {
             return Err(RunError::Stopped);
         }
         while let Some(frame) = service.poll_transmit() {
@@ -151,7 +147,7 @@ where
                 return Ok(value);
             }
         }
-        let current = now(clock);
+        let current = clock.now();
         if deadline.is_some_and(|deadline| current >= deadline) {
             return Err(RunError::Deadline);
         }
@@ -177,7 +173,7 @@ where
             () = &mut shutdown => return Err(RunError::Stopped),
             received = bus.recv() => {
                 let frame = received.map_err(RunError::Io)?;
-                service.handle_frame(now(clock), &frame);
+                service.handle_frame(clock.now(), &frame);
             }
             () = sleep => {}
         }
@@ -251,7 +247,7 @@ impl<B: AsyncBus> SdoClient<B> {
         sub: u8,
         transfer: Transfer<'_>,
     ) -> Result<Upload, Error> {
-        let start = now(&self.clock);
+        let start = self.clock.now();
         let object = self.object(index, sub);
         transfer.start(&mut self.core, start, object)?;
         let limit = transfer.bound(self.core.config());

@@ -5,7 +5,7 @@
 
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Mutex, mpsc};
 use std::thread;
 use std::time::{Duration, Instant as StdInstant};
 
@@ -27,7 +27,7 @@ use eds2rust_runtime::{CanId, Frame, Instant, Service};
 const DEVICE: u8 = 0x20;
 /// The master's heartbeat period.
 const PERIOD: Duration = Duration::from_millis(20);
-/// How long the device takes to read its slow object.
+/// How long the device takes to read its slow object unless released.
 const SLOW: Duration = Duration::from_millis(300);
 
 fn node(id: u8) -> NodeId {
@@ -67,21 +67,28 @@ impl Entry for Blob {
     type Value = eds2rust_runtime::od::bytes::Domain;
 }
 
-/// A memory store whose object 0x2000:01 takes [`SLOW`] to read.
-struct SlowStore(MemoryStore);
+/// A memory store whose object 0x2000:01 takes [`SLOW`] to read, or less
+/// when released: it tells `started` when the read begins, then answers
+/// when `release` says so or [`SLOW`] has passed.
+struct SlowStore {
+    store: MemoryStore,
+    started: mpsc::Sender<()>,
+    release: mpsc::Receiver<()>,
+}
 
 impl ObjectStore for SlowStore {
     fn read(&mut self, index: u16, sub: u8, out: &mut Vec<u8>) -> Result<(), AbortCode> {
         if (index, sub) == (0x2000, 1) {
-            thread::sleep(SLOW);
+            let _ = self.started.send(());
+            let _ = self.release.recv_timeout(SLOW);
         }
-        self.0.read(index, sub, out)
+        self.store.read(index, sub, out)
     }
     fn check_write(&mut self, index: u16, sub: u8, size: Option<usize>) -> Result<(), AbortCode> {
-        self.0.check_write(index, sub, size)
+        self.store.check_write(index, sub, size)
     }
     fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), AbortCode> {
-        self.0.write(index, sub, data)
+        self.store.write(index, sub, data)
     }
 }
 
@@ -128,6 +135,10 @@ struct Rig {
     bus: VirtualBus,
     master: Master<VirtualPort>,
     frames: Arc<Mutex<Vec<(StdInstant, Frame)>>>,
+    /// Told when the device begins reading its slow object.
+    slow_read_started: Option<mpsc::Receiver<()>>,
+    /// Lets the slow read answer at once.
+    release_slow_read: mpsc::Sender<()>,
     stop: Arc<AtomicBool>,
     threads: Vec<thread::JoinHandle<()>>,
 }
@@ -154,6 +165,8 @@ impl Rig {
         let master_port = bus.attach();
         let mut port = bus.attach();
         let halt = stop.clone();
+        let (started, slow_read_started) = mpsc::channel();
+        let (release_slow_read, release) = mpsc::channel();
         threads.push(thread::spawn(move || {
             let mut store = MemoryStore::new();
             store.insert_fixed(0x1017, 0, AccessRight::Rw, &50u16.to_le_bytes());
@@ -168,7 +181,11 @@ impl Rig {
             let mut device = Device {
                 sdo: SdoServer::new(
                     ServerConfig::new(Channel::default_for(id)),
-                    SlowStore(store),
+                    SlowStore {
+                        store,
+                        started,
+                        release,
+                    },
                 ),
                 nmt: NmtSlave::new(id),
                 heartbeat: HeartbeatProducer::new(id, Duration::from_millis(50)),
@@ -189,6 +206,8 @@ impl Rig {
             bus,
             master,
             frames,
+            slow_read_started: Some(slow_read_started),
+            release_slow_read,
             stop,
             threads,
         }
@@ -315,14 +334,18 @@ fn nmt_command_bytes_and_the_state_the_node_reports() {
 fn a_pdo_received_during_an_sdo_transfer_is_kept_and_queued() {
     let mut rig = Rig::new();
     rig.master.core_mut().pdo_rx.watch(0x1A0, 2, None).unwrap();
-    // Another node sends its TPDO1 (0x1A0) while the slow read runs.
+    // Another node sends its TPDO1 (0x1A0) while the slow read runs; the
+    // device answers the read only after that.
     let sender = rig.bus.attach();
+    let started = rig.slow_read_started.take().unwrap();
+    let release = rig.release_slow_read.clone();
     let pdo = thread::spawn(move || {
-        thread::sleep(Duration::from_millis(100));
+        started.recv().unwrap();
         sender.transmit(&frame(0x1A0, &[0x11, 0x22]));
         sender.transmit(&frame(0x721, &[0x00]));
         // EMCY 0x8110 (CAN overrun), error register 0x11.
         sender.transmit(&frame(0x0A1, &[0x10, 0x81, 0x11, 0, 0, 0, 0, 0]));
+        release.send(()).unwrap();
     });
     assert_eq!(
         rig.master.read::<SlowValue>(node(DEVICE)).unwrap(),

@@ -169,7 +169,7 @@ pub fn spawn_device(mut port: VirtualPort) -> JoinHandle<()> {
         let mut device = Device::new();
         device.nmt.boot_complete();
         device.heartbeat.set_state(device.nmt.state());
-        device.heartbeat.start(driver::now(&clock));
+        device.heartbeat.start(clock.now());
         let pending = std::future::pending();
         let _ = driver::serve(
             &mut port,

@@ -181,7 +181,7 @@ impl Harness {
     {
         let clock = Clock::new();
         let mut harness = Harness {
-            clock,
+            clock: clock.clone(),
             port: None,
             stop: Arc::new(AtomicBool::new(false)),
             threads: Vec::new(),
@@ -269,7 +269,7 @@ impl Harness {
         }
         let stop = Arc::clone(&self.stop);
         let log = Arc::clone(&self.device_log);
-        let clock = self.clock;
+        let clock = self.clock.clone();
         self.threads.push(std::thread::spawn(move || {
             blocking::serve(&mut port, &clock, &mut device, &stop, None, |event| {
                 if !matches!(event, SimEvent::Sdo(_) | SimEvent::Written { .. }) {
@@ -282,7 +282,7 @@ impl Harness {
 
     /// The clock master and simulator share.
     pub fn clock(&self) -> Clock {
-        self.clock
+        self.clock.clone()
     }
 
     /// The master's port (once).

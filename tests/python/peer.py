@@ -375,11 +375,24 @@ class Peer:
             })
         return {"maps": maps}
 
-    def op_tpdo_wait(self, cmd):
-        """Waits for the next reception of TPDO `number` and returns its data
-        and every variable's decoded raw value."""
+    def op_tpdo_arm(self, cmd):
+        """Forgets the receptions of TPDO `number` so far: a tpdo_wait started
+        after this command's reply returns on the first reception after it
+        (python-canopen's wait_for_reception would miss a TPDO that comes
+        before its thread starts waiting)."""
         pdo_map = self.remote_node(cmd["node"]).tpdo.map[cmd["number"]]
-        pdo_map.wait_for_reception(timeout=cmd.get("timeout", 2.0))
+        with pdo_map.receive_condition:
+            pdo_map.is_received = False
+        return {}
+
+    def op_tpdo_wait(self, cmd):
+        """Waits for a reception of TPDO `number` since its last tpdo_arm (any
+        reception so far, if it was never armed) and returns the data of the
+        latest and every variable's decoded raw value."""
+        pdo_map = self.remote_node(cmd["node"]).tpdo.map[cmd["number"]]
+        with pdo_map.receive_condition:
+            pdo_map.receive_condition.wait_for(
+                lambda: pdo_map.is_received, timeout=cmd.get("timeout", 2.0))
         if not pdo_map.is_received:
             raise ValueError("TPDO %d of node %d was not received" %
                              (cmd["number"], cmd["node"]))

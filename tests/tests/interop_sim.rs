@@ -146,6 +146,12 @@ fn start_and_receive(
     numbers: &[u64],
     synchronous: bool,
 ) -> Vec<(Vec<u8>, Vec<i128>)> {
+    // Armed before the node starts: each wait returns on the first
+    // reception after this, however late its thread starts waiting.
+    for number in numbers {
+        py.command_ok(json!({"op": "tpdo_arm", "node": node, "number": number}))
+            .unwrap_or_else(|e| panic!("{e}"));
+    }
     let ids: Vec<u64> = numbers
         .iter()
         .map(|number| {
@@ -153,8 +159,6 @@ fn start_and_receive(
                 .unwrap_or_else(|e| panic!("{e}"))
         })
         .collect();
-    // Let python's waiting threads start before the first TPDO can come.
-    std::thread::sleep(Duration::from_millis(200));
     py.command_ok(json!({"op": "nmt_command", "node": node, "command": 1}))
         .unwrap_or_else(|e| panic!("{e}"));
     let deadline = StdInstant::now() + Duration::from_secs(5);
@@ -348,10 +352,18 @@ fn derived_pdos_are_configured_and_read_back_by_python() {
     let mut device_port = bus.attach();
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
+    let device_clock = clock.clone();
     let serving = std::thread::spawn(move || {
         let mut device = device;
-        blocking::serve(&mut device_port, &clock, &mut device, &flag, None, |_| {})
-            .expect("the simulator's bus");
+        blocking::serve(
+            &mut device_port,
+            &device_clock,
+            &mut device,
+            &flag,
+            None,
+            |_| {},
+        )
+        .expect("the simulator's bus");
         device
     });
     let mut sdo = SdoClient::new(bus.attach(), ClientConfig::new(Channel::default_for(drive)));
@@ -380,9 +392,10 @@ fn derived_pdos_are_configured_and_read_back_by_python() {
     };
     let cob = ControlVelocity::can_id(drive) as u16;
     let frame = Frame::new(CanId::Standard(cob), &command.encode()).expect("RPDO4 frame");
-    std::thread::sleep(Duration::from_millis(50));
+    // The device takes its frames in send order on its one port: it is
+    // operational before the RPDO, and has written the RPDO before it
+    // answers the SDO reads below.
     watch.send(&frame).expect("send RPDO4");
-    std::thread::sleep(Duration::from_millis(50));
     assert_eq!(
         sdo.read::<od::TargetVelocity>().expect("0x60FF"),
         command.velocity

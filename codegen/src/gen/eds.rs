@@ -79,7 +79,7 @@ pub fn to_eds(device: &Device) -> String {
 /// and writes the result with [`to_eds`].
 ///
 /// Errors: an unknown variant, or an override of an entry the device lacks.
-pub fn to_eds_variant(device: &Device, variant: &str) -> Result<String, String> {
+pub fn to_eds_variant(device: &Device, variant: &str) -> Result<String, super::VariantError> {
     super::apply_variant(device, variant).map(|d| to_eds(&d))
 }
 

@@ -11,7 +11,61 @@ pub mod rust;
 
 pub use eds::{to_eds, to_eds_variant};
 
-use crate::ir::{Device, Literal, Value};
+use core::fmt;
+
+use crate::ir::{Device, Literal, Origin, Value};
+
+/// Why [`apply_variant`] (and [`to_eds_variant`]) could not make a device
+/// variant.
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[non_exhaustive]
+pub enum VariantError {
+    /// The device has no variant of this name; `known` are the names it has.
+    Unknown { name: String, known: Vec<String> },
+    /// An override of the variant names an entry the device does not have.
+    MissingEntry {
+        variant: String,
+        index: u16,
+        subindex: u8,
+        /// Where the override is written.
+        origin: Origin,
+    },
+}
+
+impl fmt::Display for VariantError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            VariantError::Unknown { name, known } if known.is_empty() => {
+                write!(
+                    f,
+                    "unknown variant `{name}`: the device defines no variants"
+                )
+            }
+            VariantError::Unknown { name, known } => write!(
+                f,
+                "unknown variant `{name}`; the device defines: {}",
+                known.join(", ")
+            ),
+            VariantError::MissingEntry {
+                variant,
+                index,
+                subindex,
+                origin,
+            } => {
+                if !origin.file.is_empty() {
+                    write!(f, "{}:{}: ", origin.file, origin.line)?;
+                }
+                write!(
+                    f,
+                    "variant `{variant}` overrides 0x{index:04X} sub {subindex}, \
+                     which the device does not have"
+                )
+            }
+        }
+    }
+}
+
+impl std::error::Error for VariantError {}
 
 /// The device as its product variant `name`.
 ///
@@ -25,18 +79,14 @@ use crate::ir::{Device, Literal, Value};
 /// (network defaults, not dictionary content) and its description. The
 /// result keeps the device's list of variants.
 ///
-/// Errors: an unknown variant name (the message lists the known ones), or an
-/// override that names an index/subindex the device does not have.
-pub fn apply_variant(device: &Device, name: &str) -> Result<Device, String> {
+/// Errors: an unknown variant name ([`VariantError::Unknown`], with the
+/// known ones), or an override that names an index/subindex the device does
+/// not have ([`VariantError::MissingEntry`]).
+pub fn apply_variant(device: &Device, name: &str) -> Result<Device, VariantError> {
     let Some(variant) = device.variants.iter().find(|v| v.name == name) else {
-        let known: Vec<&str> = device.variants.iter().map(|v| v.name.as_str()).collect();
-        return Err(if known.is_empty() {
-            format!("unknown variant `{name}`: the device defines no variants")
-        } else {
-            format!(
-                "unknown variant `{name}`; the device defines: {}",
-                known.join(", ")
-            )
+        return Err(VariantError::Unknown {
+            name: name.into(),
+            known: device.variants.iter().map(|v| v.name.clone()).collect(),
         });
     };
     let mut out = device.clone();
@@ -76,10 +126,12 @@ pub fn apply_variant(device: &Device, name: &str) -> Result<Device, String> {
             .get_mut(&o.index)
             .and_then(|obj| obj.entries.get_mut(&o.subindex))
         else {
-            return Err(format!(
-                "variant `{name}` overrides 0x{:04X} sub {}, which the device does not have",
-                o.index, o.subindex
-            ));
+            return Err(VariantError::MissingEntry {
+                variant: name.into(),
+                index: o.index,
+                subindex: o.subindex,
+                origin: o.origin.clone(),
+            });
         };
         if o.default.is_some() {
             entry.default.clone_from(&o.default);
@@ -186,10 +238,33 @@ mod tests {
     #[test]
     fn variant_errors_name_the_problem() {
         let err = apply_variant(&device(), "small").unwrap_err();
-        assert!(err.contains("small") && err.contains("big"), "{err}");
+        assert_eq!(
+            err.to_string(),
+            "unknown variant `small`; the device defines: big"
+        );
+        let err = apply_variant(&Device::default(), "small").unwrap_err();
+        assert_eq!(
+            err.to_string(),
+            "unknown variant `small`: the device defines no variants"
+        );
         let mut d = device();
         d.variants[0].overrides[0].index = 0x2000;
+        d.variants[0].overrides[0].origin = Origin {
+            file: "big.yaml".into(),
+            line: 12,
+        };
         let err = apply_variant(&d, "big").unwrap_err();
-        assert!(err.contains("0x2000 sub 1"), "{err}");
+        assert!(matches!(
+            err,
+            VariantError::MissingEntry {
+                index: 0x2000,
+                subindex: 1,
+                ..
+            }
+        ));
+        assert_eq!(
+            err.to_string(),
+            "big.yaml:12: variant `big` overrides 0x2000 sub 1, which the device does not have"
+        );
     }
 }

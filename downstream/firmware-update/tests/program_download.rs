@@ -48,7 +48,7 @@ fn a_mebibyte_program_is_streamed_confirmed_and_started() {
     let clock = Clock::new();
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
-    let device_clock = clock;
+    let device_clock = clock.clone();
     let served = std::thread::spawn(move || {
         let mut device = Device::new(
             slave::od::OBJECTS,

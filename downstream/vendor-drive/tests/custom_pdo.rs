@@ -38,7 +38,9 @@ fn configured_over_sdo_applied_and_received() {
     let mut port = bus.attach();
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
+    let device_clock = clock.clone();
     let serving = std::thread::spawn(move || {
+        let clock = device_clock;
         let mut device = Device::new(od::OBJECTS, DeviceConfig::node(drive), (), clock.now());
         blocking::serve(&mut port, &clock, &mut device, &flag, None, |_| {}).unwrap();
         device
@@ -66,9 +68,10 @@ fn configured_over_sdo_applied_and_received() {
     watch
         .send(&Frame::new(CanId::Standard(0), &[0x01, drive.get()]).unwrap())
         .unwrap();
-    std::thread::sleep(Duration::from_millis(30));
 
-    // The RPDO is written into the drive's objects.
+    // The RPDO is written into the drive's objects. The device takes its
+    // frames in send order on its one port: it is operational before the
+    // RPDO, and has written the RPDO before it answers the SDO reads.
     let command = ControlVelocity {
         // Enable operation, as the runtime's CiA 402 command says it.
         control: cia402::Controlword::from_command(cia402::Command::EnableOperation).into(),
@@ -78,7 +81,6 @@ fn configured_over_sdo_applied_and_received() {
     watch
         .send(&Frame::new(CanId::Standard(id), &command.encode()).unwrap())
         .unwrap();
-    std::thread::sleep(Duration::from_millis(30));
     assert_eq!(sdo.read::<od::Controlword>().unwrap(), command.control);
     assert_eq!(sdo.read::<od::TargetVelocity>().unwrap(), command.velocity);
 

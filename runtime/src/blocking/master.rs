@@ -342,7 +342,8 @@ impl<B: Bus> Master<B> {
             for limit in [deadline, timer].into_iter().flatten() {
                 wake = wake.min(limit);
             }
-            if let Some(frame) = self.bus.recv(wake - now).map_err(RunError::Io)? {
+            let received = super::recv_until(&mut self.bus, &self.clock, now, wake);
+            if let Some(frame) = received.map_err(RunError::Io)? {
                 self.core.handle_frame(self.clock.now(), &frame);
             }
         }

@@ -1,9 +1,9 @@
 use std::sync::Arc;
-use std::vec;
 
 use super::*;
 use crate::od::NodeId;
 use crate::sdo::{AbortCode, Channel, SdoError};
+use crate::transport::ManualClock;
 use crate::transport::virtual_bus::VirtualBus;
 use crate::{CanId, Frame};
 
@@ -91,15 +91,15 @@ fn run_sends_feeds_frames_and_stops_on_break() {
 fn run_runs_timers_and_honours_the_deadline() {
     let bus = VirtualBus::new();
     let mut port = bus.attach();
-    let clock = Clock::new();
+    let time = ManualClock::new();
+    let clock = time.clock();
     let mut core = Pinger::new(None, 0x200, Duration::from_millis(10));
     let mut ticks = Vec::new();
-    let start = std::time::Instant::now();
     let result = run(
         &mut port,
         &clock,
         &mut core,
-        start + Duration::from_millis(60),
+        Instant::from_millis(60),
         |event| {
             if let PingEvent::Tick(at) = event {
                 ticks.push(at);
@@ -108,14 +108,54 @@ fn run_runs_timers_and_honours_the_deadline() {
         },
     );
     assert!(matches!(result, Err(RunError::Deadline)));
-    assert!(start.elapsed() >= Duration::from_millis(60));
-    assert!((3..=6).contains(&ticks.len()), "{ticks:?}");
-    // Each tick came at or after its deadline.
-    let mut due = Instant::ZERO + Duration::from_millis(10);
-    for tick in ticks {
-        assert!(tick >= due);
-        due = tick + Duration::from_millis(10);
-    }
+    assert_eq!(time.now(), Instant::from_millis(60));
+    // Each tick came exactly at its deadline; the one due at the deadline
+    // itself did not run.
+    let due: Vec<Instant> = (1..=5).map(|n| Instant::from_millis(10 * n)).collect();
+    assert_eq!(ticks, due);
+}
+
+#[test]
+fn a_manual_clock_takes_frames_already_there_and_never_waits() {
+    let bus = VirtualBus::new();
+    let mut port = bus.attach();
+    let peer = bus.attach();
+    let time = ManualClock::new();
+    let clock = time.clock();
+    let mut core = Pinger::new(None, 0x200, Duration::from_secs(3600));
+    peer.transmit(&frame(0x200, &[1]));
+    let real = std::time::Instant::now();
+    let mut seen = Vec::new();
+    let result = run(
+        &mut port,
+        &clock,
+        &mut core,
+        Instant::from_millis(10_000),
+        |event| {
+            seen.push(event);
+            ControlFlow::<()>::Continue(())
+        },
+    );
+    assert!(matches!(result, Err(RunError::Deadline)));
+    // The frame came at time zero; ten seconds passed on the clock only.
+    assert_eq!(seen, [PingEvent::Got(frame(0x200, &[1]))]);
+    assert_eq!(time.now(), Instant::from_millis(10_000));
+    assert!(real.elapsed() < Duration::from_secs(5));
+    // A frame sent later is taken at the clock's time then.
+    time.advance(Duration::from_millis(5));
+    peer.transmit(&frame(0x200, &[2]));
+    let got = run(
+        &mut port,
+        &clock,
+        &mut core,
+        Deadline::NEVER,
+        |event| match event {
+            PingEvent::Got(frame) => ControlFlow::Break(frame),
+            PingEvent::Tick(_) => ControlFlow::Continue(()),
+        },
+    );
+    assert_eq!(got.unwrap(), frame(0x200, &[2]));
+    assert_eq!(time.now(), Instant::from_millis(10_005));
 }
 
 #[test]
@@ -125,25 +165,34 @@ fn serve_stops_on_the_flag() {
     let peer = bus.attach();
     let stop = Arc::new(AtomicBool::new(false));
     let flag = Arc::clone(&stop);
+    let (seen, events) = std::sync::mpsc::channel();
     let server = std::thread::spawn(move || {
         let clock = Clock::new();
         let mut core = Pinger::new(None, 0x200, Duration::from_secs(60));
-        let mut seen = Vec::new();
-        serve(&mut port, &clock, &mut core, &flag, None, |e| seen.push(e)).unwrap();
-        seen
+        serve(&mut port, &clock, &mut core, &flag, None, |e| {
+            seen.send(e).unwrap();
+        })
+        .unwrap();
     });
     peer.transmit(&frame(0x200, &[1]));
     peer.transmit(&frame(0x201, &[2]));
     peer.transmit(&frame(0x200, &[3]));
-    std::thread::sleep(Duration::from_millis(50));
-    stop.store(true, Ordering::Relaxed);
-    let seen = server.join().unwrap();
+    // Frames arrive in send order, so 0x201 was handled (and not
+    // reported) before the last event came.
+    let wait = Duration::from_secs(5);
     assert_eq!(
-        seen,
-        vec![
-            PingEvent::Got(frame(0x200, &[1])),
-            PingEvent::Got(frame(0x200, &[3]))
-        ]
+        events.recv_timeout(wait).unwrap(),
+        PingEvent::Got(frame(0x200, &[1]))
+    );
+    assert_eq!(
+        events.recv_timeout(wait).unwrap(),
+        PingEvent::Got(frame(0x200, &[3]))
+    );
+    stop.store(true, Ordering::Relaxed);
+    server.join().unwrap();
+    assert_eq!(
+        events.try_recv(),
+        Err(std::sync::mpsc::TryRecvError::Disconnected)
     );
 }
 
@@ -165,24 +214,31 @@ fn serve_ends_at_its_deadline() {
 fn run_and_serve_take_deadlines_in_the_cores_time() {
     let bus = VirtualBus::new();
     let mut port = bus.attach();
-    let clock = Clock::new();
+    let time = ManualClock::new();
+    let clock = time.clock();
     let mut core = Pinger::new(None, 0x200, Duration::from_millis(10));
     let mut ticks = 0;
     let deadline = clock.now() + Duration::from_millis(35);
-    let result = run(&mut port, &clock, &mut core, deadline, |event| {
-        if let PingEvent::Tick(_) = event {
-            ticks += 1;
-        }
-        ControlFlow::<()>::Continue(())
-    });
+    let result = run(
+        &mut port,
+        &clock,
+        &mut core,
+        deadline,
+        |event| {
+            if let PingEvent::Tick(_) = event {
+                ticks += 1;
+            }
+            ControlFlow::<()>::Continue(())
+        },
+    );
     assert!(matches!(result, Err(RunError::Deadline)));
-    assert!(clock.now() >= deadline);
-    assert!((1..=3).contains(&ticks), "{ticks}");
+    assert_eq!(clock.now(), deadline);
+    assert_eq!(ticks, 3);
 
     let stop = AtomicBool::new(false);
     let deadline = clock.now() + Duration::from_millis(20);
     serve(&mut port, &clock, &mut core, &stop, deadline, |_| {}).unwrap();
-    assert!(clock.now() >= deadline);
+    assert_eq!(clock.now(), deadline);
     // Deadline::NEVER with the stop flag already set: returns at once.
     stop.store(true, Ordering::Relaxed);
     serve(&mut port, &clock, &mut core, &stop, Deadline::NEVER, |_| {}).unwrap();

@@ -91,7 +91,7 @@ use stream::Queue;
 /// use eds2rust_runtime::tokio::Master;
 /// use eds2rust_runtime::transport::virtual_bus::VirtualBus;
 ///
-/// # #[tokio::main(flavor = "current_thread")]
+/// # #[tokio::main(flavor = "current_thread", start_paused = true)]
 /// # async fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// let bus = VirtualBus::new();
 /// let monitor = bus.attach();
@@ -173,7 +173,7 @@ impl Shared {
     }
 
     fn now(&self) -> Instant {
-        super::now(&self.clock)
+        self.clock.now()
     }
 
     /// Marks the driver stopped for `reason`: pending calls fail, streams

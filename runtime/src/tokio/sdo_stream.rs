@@ -9,7 +9,7 @@ use core::time::Duration;
 use std::io::{self, Read, Write};
 use std::vec::Vec;
 
-use super::{Error, SdoClient, now, run_loop};
+use super::{Error, SdoClient, run_loop};
 use crate::blocking::Object;
 use crate::blocking::stream::{
     Pump, announced, bound, finish_download, finish_upload, start_download, start_upload,
@@ -38,7 +38,7 @@ impl<B: AsyncBus> SdoClient<B> {
         R: Read + Send,
         P: FnMut(Progress) + Send,
     {
-        let start = now(&self.clock);
+        let start = self.clock.now();
         let announced = announced(size)?;
         let object = self.object(index, sub);
         start_download(&mut self.core, start, object, announced, method)?;
@@ -64,7 +64,7 @@ impl<B: AsyncBus> SdoClient<B> {
         W: Write + Send,
         P: FnMut(Progress) + Send,
     {
-        let start = now(&self.clock);
+        let start = self.clock.now();
         let object = self.object(index, sub);
         start_upload(&mut self.core, start, object, method)?;
         let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);

@@ -75,7 +75,7 @@ async fn run_and_serve_take_deadlines_in_the_cores_time() {
     let clock = clock();
     let mut core = ticker();
     let mut ticks = Vec::new();
-    let deadline = now(&clock) + Duration::from_millis(55);
+    let deadline = clock.now() + Duration::from_millis(55);
     let result = run(&mut port, &clock, &mut core, deadline, |event| {
         if let Err(at) = event {
             ticks.push(at);
@@ -85,11 +85,11 @@ async fn run_and_serve_take_deadlines_in_the_cores_time() {
     .await;
     assert!(matches!(result, Err(RunError::Deadline)));
     // Paused time: the deadline is met exactly, after five ticks.
-    assert_eq!(now(&clock), deadline);
+    assert_eq!(clock.now(), deadline);
     assert_eq!(ticks.len(), 5);
 
     let mut seen = 0;
-    let deadline = now(&clock) + Duration::from_millis(30);
+    let deadline = clock.now() + Duration::from_millis(30);
     serve(
         &mut port,
         &clock,
@@ -100,7 +100,7 @@ async fn run_and_serve_take_deadlines_in_the_cores_time() {
     )
     .await
     .unwrap();
-    assert_eq!(now(&clock), deadline);
+    assert_eq!(clock.now(), deadline);
     // Ticks at 60, 70 and 80 ms.
     assert_eq!(seen, 3);
     // No deadline and a shutdown that has come: returns at once.
@@ -114,7 +114,7 @@ async fn run_and_serve_take_deadlines_in_the_cores_time() {
     )
     .await
     .unwrap();
-    assert_eq!(now(&clock), deadline);
+    assert_eq!(clock.now(), deadline);
 }
 
 #[::tokio::test(start_paused = true)]

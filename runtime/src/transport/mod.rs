@@ -2,8 +2,8 @@
 //!
 //! - [`Bus`]: a blocking CAN interface; `AsyncBus` (feature `tokio`) its
 //!   async counterpart.
-//! - [`clock::Clock`]: maps the std clock to the [`crate::Instant`] of the
-//!   protocol cores.
+//! - [`Clock`]: maps the std clock, tokio's clock or a [`ManualClock`]
+//!   (tests) to the [`crate::Instant`] of the protocol cores.
 //! - [`virtual_bus`]: an in-process CAN bus for simulators and tests, with an
 //!   optional bit-time model ([`wire`] counts the bits of a frame).
 //! - [`candump`]: reads and writes the log and text formats of `candump`.
@@ -28,7 +28,7 @@ pub mod trc;
 pub mod virtual_bus;
 pub mod wire;
 
-pub use clock::Clock;
+pub use clock::{Clock, ManualClock};
 
 /// A blocking CAN interface: SocketCAN, an `embedded-can` device, a port of
 /// the virtual bus, or a test peer.

@@ -54,8 +54,6 @@ pub static NO_VELOCITY: [ObjectInfo; 5] = [
 /// The simulated drive.
 pub struct Sim {
     pub clock: Clock,
-    /// How `clock` is read: `Clock::now` (std), or tokio's paused clock.
-    pub now: fn(&Clock) -> Instant,
     pub last: Instant,
     pub device: DeviceStateMachine,
     pub position: i64,
@@ -74,16 +72,11 @@ pub struct Sim {
 }
 
 impl Sim {
+    /// The drive reading `clock` (the std clock, or tokio's).
     pub fn new(clock: Clock, config: DeviceConfig) -> Sim {
-        Sim::with_now(clock, Clock::now, config)
-    }
-
-    /// The drive reading `clock` with `now`.
-    pub fn with_now(clock: Clock, now: fn(&Clock) -> Instant, config: DeviceConfig) -> Sim {
-        let at = now(&clock);
+        let at = clock.now();
         Sim {
             clock,
-            now,
             last: at,
             device: DeviceStateMachine::new(at, config),
             position: 0,
@@ -102,7 +95,7 @@ impl Sim {
 
     /// The drive's time.
     pub fn now(&self) -> Instant {
-        (self.now)(&self.clock)
+        self.clock.now()
     }
 
     /// Runs the device and the motion model to now.

@@ -173,7 +173,9 @@ mod tokio_tests {
             let second = AsyncBus::recv(&mut a).await.unwrap();
             (first, second)
         });
-        ::tokio::time::sleep(Duration::from_millis(10)).await;
+        // One thread: the task runs up to its first (pending) receive.
+        ::tokio::task::yield_now().await;
+        assert!(!task.is_finished());
         AsyncBus::send(&mut b, &frame(0x1, &[1])).await.unwrap();
         AsyncBus::send(&mut b, &frame(0x2, &[2])).await.unwrap();
         let (first, second) = task.await.unwrap();

@@ -60,8 +60,9 @@ fn removing_or_renaming_objects_keeps_other_paths() {
     let start = Instant::now();
     let (mut removals, mut renames, mut skipped) = (0, 0, 0);
     for file in files {
-        let Some(device) = crate::input::read_device(&file, &Options::lenient()).device else {
-            continue;
+        let read = crate::input::read_device(&file, &Options::lenient());
+        let Some(device) = read.device else {
+            panic!("{}: no device: {:?}", file.display(), read.diagnostics);
         };
         let before = device_names(&device);
         let profile = Profile::of(&device);
