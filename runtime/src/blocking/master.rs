@@ -10,6 +10,7 @@ use std::vec::Vec;
 
 mod drive;
 pub(crate) mod lss;
+mod pdo;
 
 pub use drive::{Cia402Error, DRIVE_EVENTS_KEPT, DriveHandle};
 pub use lss::LssRequestError;
@@ -20,8 +21,6 @@ use super::{
 use crate::master::{self, MasterEvent};
 use crate::nmt::NmtCommand;
 use crate::od::{self, Entry, NodeId};
-use crate::pdo::PdoConfig;
-use crate::pdo::blocking::{PdoConfigError, SdoAccess, run_steps};
 use crate::sdo::client::Method;
 use crate::sdo::typed::{self, LengthNote};
 use crate::time::Deadline;
@@ -540,31 +539,6 @@ impl<B: Bus> Master<B> {
     {
         let (buf, len) = encode::<E>(value)?;
         self.download(node, E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
-    }
-
-    /// Configures a PDO of `node` as [`crate::pdo::blocking::configure_pdo`]
-    /// does (same steps, read-backs and errors).
-    pub fn configure_pdo(
-        &mut self,
-        node: NodeId,
-        config: &PdoConfig<'_>,
-    ) -> Result<(), PdoConfigError> {
-        run_steps(&mut NodeSdo { master: self, node }, config)
-    }
-}
-
-/// One node's objects through a [`Master`], for the PDO configuration.
-struct NodeSdo<'a, B> {
-    master: &'a mut Master<B>,
-    node: NodeId,
-}
-
-impl<B: Bus> SdoAccess for NodeSdo<'_, B> {
-    fn download(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), Error> {
-        self.master.download(self.node, index, sub, data)
-    }
-    fn upload(&mut self, index: u16, sub: u8) -> Result<Vec<u8>, Error> {
-        self.master.upload(self.node, index, sub)
     }
 }
 

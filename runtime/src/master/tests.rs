@@ -65,7 +65,12 @@ fn own_sync_drives_the_synchronous_rpdos_and_is_reported_on_request() {
     let mut m = Master::new(node(1), Duration::ZERO);
     m.sync = Some(SyncProducer::new(Duration::from_millis(10), Some(2)).unwrap());
     // RPDO1 of node 5, synchronous cyclic every SYNC.
-    let i = m.add_pdo_tx(TransmitterConfig::new(0x205, 1)).unwrap();
+    let i = m
+        .add_pdo_tx(TransmitterConfig::new(
+            PdoCobId(0x205),
+            TransmissionType::SynchronousCyclic(1),
+        ))
+        .unwrap();
     m.set_sync_events(true);
     m.start(ms(0));
     assert_eq!(drain_frames(&mut m), ["701#00"]);
@@ -126,7 +131,7 @@ fn the_deadline_is_the_earliest_of_all_cores_and_only_due_cores_run() {
 fn every_core_sees_every_frame() {
     let mut m = Master::new(node(1), Duration::ZERO);
     m.consumer.monitor(node(5), Duration::from_millis(500));
-    m.pdo_rx.watch(0x185, 2, None).unwrap();
+    m.pdo_rx.watch(PdoCobId(0x185), 2, None).unwrap();
     m.add_sdo_client(node(5), ClientConfig::new(Channel::default_for(node(5))));
     m.start(ms(0));
     drain_frames(&mut m);
@@ -163,7 +168,7 @@ fn every_core_sees_every_frame() {
                 emcy: Emcy::parse(&[0x10, 0x32, 0x05, 0, 0, 0, 0, 0]).unwrap()
             }),
             MasterEvent::Pdo(PdoEvent::Received {
-                cob_id: 0x185,
+                can_id: CanId::Standard(0x185),
                 data: [0x37, 0x02, 0, 0, 0, 0, 0, 0],
                 len: 2,
                 at: ms(2)
@@ -180,7 +185,10 @@ fn every_core_sees_every_frame() {
         ]
     );
     assert_eq!(m.nmt.state(node(5)), Some(to));
-    assert_eq!(m.pdo_rx.latest_data(0x185), Some(&[0x37, 0x02][..]));
+    assert_eq!(
+        m.pdo_rx.latest_data(CanId::Standard(0x185)),
+        Some(&[0x37, 0x02][..])
+    );
 }
 
 #[test]

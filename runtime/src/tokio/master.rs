@@ -15,6 +15,7 @@ use ::tokio::sync::{Notify, oneshot};
 mod drive;
 mod driver;
 mod lss;
+mod pdo;
 mod sdo;
 mod stream;
 mod streamed;
@@ -25,12 +26,13 @@ pub use driver::Driver;
 pub use stream::{Events, PDO_QUEUE_CAPACITY, Pdos};
 
 use super::Error;
+use crate::CanId;
 use crate::blocking::{Upload, transfer_end};
 use crate::lss::LssEvent;
 use crate::master::{self, MasterEvent};
 use crate::nmt::NmtCommand;
 use crate::od::{self, NodeId};
-use crate::pdo::{CobId, PdoEvent, WatchError};
+use crate::pdo::{PdoCobId, PdoEvent, WatchError};
 use crate::sdo::typed::LengthNote;
 use crate::transport::{AsyncBus, Clock};
 use crate::{Instant, Service};
@@ -154,7 +156,7 @@ struct State {
     /// SDO transfers with one node take turns.
     turns: BTreeMap<NodeId, Arc<::tokio::sync::Mutex<()>>>,
     events: Vec<Arc<Queue<MasterEvent>>>,
-    pdos: Vec<(u16, Arc<Queue<PdoEvent>>)>,
+    pdos: Vec<(CanId, Arc<Queue<PdoEvent>>)>,
     notes: VecDeque<(NodeId, LengthNote)>,
     unobserved: u64,
     handles: usize,
@@ -259,7 +261,7 @@ impl State {
             MasterEvent::Pdo(e) => {
                 if !matches!(e, PdoEvent::Timeout { .. }) {
                     self.pdos.retain(|(_, q)| Arc::strong_count(q) > 1);
-                    for (_, queue) in self.pdos.iter().filter(|(id, _)| *id == e.cob_id()) {
+                    for (_, queue) in self.pdos.iter().filter(|(id, _)| *id == e.can_id()) {
                         queue.push(e);
                     }
                 }
@@ -442,8 +444,8 @@ impl Master {
     }
 
     /// [`Master::pdos`] on the COB-ID entry `cob_id` (bit 30 ignored).
-    pub fn pdos_on<P: od::Pdo>(&self, cob_id: u32) -> Result<Pdos<P>, WatchError> {
-        let id = CobId::parse(cob_id)?.id;
+    pub fn pdos_on<P: od::Pdo>(&self, cob_id: PdoCobId) -> Result<Pdos<P>, WatchError> {
+        let id = cob_id.checked_can_id()?;
         let queue = Arc::new(Queue::new(PDO_QUEUE_CAPACITY));
         let mut state = self.shared.lock();
         if !state.core.pdo_rx.is_watched(id) {
@@ -457,7 +459,7 @@ impl Master {
         drop(state);
         self.shared.wake.notify_one();
         Ok(Pdos {
-            cob_id: id,
+            can_id: id,
             queue,
             pdo: PhantomData,
         })

@@ -193,18 +193,18 @@ impl<B: Bus> Master<B> {
                 Action::Wait(until) => {
                     let pdo = self.run_until(until, |event| match event {
                         MasterEvent::Pdo(PdoEvent::Received {
-                            cob_id,
+                            can_id,
                             data,
                             len,
                             at,
-                        }) if session.is_statusword_pdo(*cob_id) => {
-                            ControlFlow::Break((*cob_id, *data, *len, *at))
+                        }) if session.is_statusword_pdo(*can_id) => {
+                            ControlFlow::Break((*can_id, *data, *len, *at))
                         }
                         _ => ControlFlow::Continue(()),
                     });
                     match pdo {
-                        Ok((cob_id, data, len, at)) => {
-                            session.on_pdo(cob_id, data.get(..len).unwrap_or(&[]), at);
+                        Ok((can_id, data, len, at)) => {
+                            session.on_pdo(can_id, data.get(..len).unwrap_or(&[]), at);
                         }
                         Err(DriveError::Deadline | DriveError::Stopped) => {}
                         Err(DriveError::Io(e)) => return Err(Cia402Error::Io(e)),

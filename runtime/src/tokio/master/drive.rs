@@ -13,7 +13,6 @@ use std::collections::VecDeque;
 use std::vec::Vec;
 
 use super::Master;
-use crate::Instant;
 use crate::blocking::Cia402Error;
 use crate::cia402::session::{Action, Read, Request, Session, SessionConfig};
 use crate::cia402::{Event, Move, State, Statusword, object};
@@ -21,6 +20,7 @@ use crate::master::MasterEvent;
 use crate::od::{NodeId, ObjectInfo};
 use crate::pdo::PdoEvent;
 use crate::tokio::Events;
+use crate::{CanId, Instant};
 
 pub use crate::blocking::DRIVE_EVENTS_KEPT;
 
@@ -121,8 +121,8 @@ impl Master {
                             ::tokio::select! {
                                 () = sleep => {}
                                 event = next_statusword_pdo(events, session) => {
-                                    if let Some((cob_id, data, len, at)) = event {
-                                        session.on_pdo(cob_id, data.get(..len).unwrap_or(&[]), at);
+                                    if let Some((can_id, data, len, at)) = event {
+                                        session.on_pdo(can_id, data.get(..len).unwrap_or(&[]), at);
                                     }
                                 }
                             }
@@ -139,15 +139,15 @@ impl Master {
 async fn next_statusword_pdo(
     events: &mut Events,
     session: &Session,
-) -> Option<(u16, [u8; 8], usize, Instant)> {
+) -> Option<(CanId, [u8; 8], usize, Instant)> {
     loop {
         match events.next().await? {
             MasterEvent::Pdo(PdoEvent::Received {
-                cob_id,
+                can_id,
                 data,
                 len,
                 at,
-            }) if session.is_statusword_pdo(cob_id) => return Some((cob_id, data, len, at)),
+            }) if session.is_statusword_pdo(can_id) => return Some((can_id, data, len, at)),
             _ => {}
         }
     }
