@@ -20,8 +20,6 @@
 //! [`PdoCobId`]; the identifier its frames carry on the bus is a
 //! [`CanId`](crate::CanId), 11-bit or 29-bit.
 
-use crate::od;
-
 mod config;
 #[doc(hidden)]
 pub mod derive;
@@ -43,7 +41,10 @@ pub use receiver::{PdoEvent, PdoReceiver, RECEIVER_EVENTS, WatchError};
 pub use transmitter::{PdoTransmitter, TransmitterConfig, TransmitterConfigError};
 
 /// The default COB-ID of `P` for `node`, or the error that says it has none.
-pub(crate) fn default_cob_id<P: od::Pdo>(node: od::NodeId) -> Result<PdoCobId, PdoError> {
+#[cfg(feature = "std")]
+pub(crate) fn default_cob_id<P: crate::od::Pdo>(
+    node: crate::od::NodeId,
+) -> Result<PdoCobId, PdoError> {
     P::default_cob_id(node).ok_or(PdoError::NoDefaultCobId {
         node,
         direction: P::DIRECTION,

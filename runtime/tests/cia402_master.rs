@@ -9,7 +9,6 @@ use std::sync::{Arc, Mutex};
 use std::thread;
 use std::time::Duration;
 
-use eds2rust_runtime::Frame;
 use eds2rust_runtime::blocking::{self, Cia402Error, Master};
 use eds2rust_runtime::cia402::requirements::{Operation, Problem};
 use eds2rust_runtime::cia402::session::StatuswordPdo;
@@ -18,10 +17,12 @@ use eds2rust_runtime::cia402::{
 };
 use eds2rust_runtime::master;
 use eds2rust_runtime::od::{DataType, NodeId, ObjectInfo};
+use eds2rust_runtime::pdo::PdoCobId;
 use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::server::{SdoServer, ServerConfig};
 use eds2rust_runtime::transport::Clock;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
+use eds2rust_runtime::{CanId, Frame};
 
 #[path = "cia402_master/sim.rs"]
 mod sim;
@@ -336,15 +337,15 @@ fn missing_objects_are_refused_before_any_frame() {
 #[test]
 fn statuswords_from_a_tpdo_without_polling() {
     let mut rig = Rig::new(DeviceConfig::default(), true);
-    let cob_id = 0x180 + u16::from(NODE);
+    let can_id = CanId::Standard(0x180 + u16::from(NODE));
     rig.master
         .core_mut()
         .pdo_rx
-        .watch(u32::from(cob_id), 2, None)
+        .watch(PdoCobId::new(can_id), 2, None)
         .unwrap();
     let config = SessionConfig {
         poll_period: None,
-        statusword_pdo: Some(StatuswordPdo { cob_id, offset: 0 }),
+        statusword_pdo: Some(StatuswordPdo { can_id, offset: 0 }),
         ..fast_config()
     };
     let mut drive = rig.master.drive(node(), &FULL, config).unwrap();
@@ -359,7 +360,7 @@ fn statuswords_from_a_tpdo_without_polling() {
         .filter(|f| f.cob_id() == Some(0x600 + u16::from(NODE)) && f.data()[0] == 0x40)
         .count();
     assert_eq!(uploads, 0);
-    assert!(seen.iter().any(|f| f.cob_id() == Some(cob_id)));
+    assert!(seen.iter().any(|f| f.id() == can_id));
 }
 
 #[test]
