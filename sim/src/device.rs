@@ -410,8 +410,8 @@ impl<B: Behaviour> Device<B> {
                 let _ = tpdo.tx.set_data(now, &data);
             }
             if requests.contains(&tpdo.number)
-                && tpdo.tx.cob_id().valid
-                && let Ok(frame) = Frame::new(CanId::Standard(tpdo.tx.cob_id().id), &data)
+                && tpdo.tx.is_enabled()
+                && let Ok(frame) = Frame::new(tpdo.tx.can_id(), &data)
             {
                 self.outbox.push_back(frame);
             }
@@ -419,10 +419,8 @@ impl<B: Behaviour> Device<B> {
     }
 
     fn receive_pdo(&mut self, now: Instant, frame: &Frame) -> bool {
-        let Some(id) = frame.cob_id() else {
-            return false;
-        };
-        let Some(i) = self.rpdos.iter().position(|r| r.cob_id == id) else {
+        let id = frame.id();
+        let Some(i) = self.rpdos.iter().position(|r| r.can_id == id) else {
             return false;
         };
         if frame.is_remote() {
