@@ -501,7 +501,7 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
     let text = docs::text(&literal.text);
     if literal.plus_node_id {
         let doc = format!(
-            " The default COB-ID entry for a node: {text} (bit 31 set means the PDO is disabled)."
+            " The default COB-ID entry value for a node: {text} (bit 31 set means the PDO is disabled)."
         );
         quote! {
             #[doc = #doc]
@@ -515,7 +515,7 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
         }
     } else {
         let doc =
-            format!(" The default COB-ID entry, {text} (bit 31 set means the PDO is disabled).");
+            format!(" The default COB-ID entry value, {text} (bit 31 set means the PDO is disabled).");
         quote! {
             #[doc = #doc]
             pub const COB_ID: #rt::od::standard::PdoCobId = #rt::od::standard::PdoCobId::from_raw(#value_lit);
