@@ -34,11 +34,11 @@ fn abort_code<T>(result: std::result::Result<T, blocking::Error>) -> Option<Abor
 
 /// The next TPDO1 of `node`, decoded.
 fn next_status(m: &mut Master<MasterPort>, node: NodeId) -> Result<Tpdo1Status> {
-    let cob = Tpdo1Status::can_id(node) as u16;
+    let tpdo1 = Tpdo1Status::can_id(node);
     let data = m.run_until(WallClock::now() + TIMEOUT, |event| match event {
         MasterEvent::Pdo(PdoEvent::Received {
-            cob_id, data, len, ..
-        }) if *cob_id == cob => ControlFlow::Break(data[..*len].to_vec()),
+            can_id, data, len, ..
+        }) if *can_id == tpdo1 => ControlFlow::Break(data[..*len].to_vec()),
         _ => ControlFlow::Continue(()),
     })?;
     Ok(Tpdo1Status::decode(&data)?)
