@@ -29,7 +29,7 @@
 //!
 //! let me = NodeId::new(1).unwrap();
 //! let drive = NodeId::new(5).unwrap();
-//! let mut master = Master::new(me, Duration::from_millis(100));
+//! let mut master = Master::new(me, Some(Duration::from_millis(100)));
 //! master.sync = Some(SyncProducer::new(Duration::from_millis(10), None).unwrap());
 //! master.add_sdo_client(drive, ClientConfig::new(Channel::default_for(drive)));
 //! master.start(Instant::ZERO);
@@ -147,10 +147,10 @@ pub struct Master {
 
 impl Master {
     /// A master with node id `node` and heartbeat producer time
-    /// `heartbeat_period` (zero: no heartbeats, only the boot-up message).
+    /// `heartbeat_period` (`None`: no heartbeats, only the boot-up message).
     /// No SYNC, no SDO clients, no PDOs; nothing runs before
     /// [`Master::start`].
-    pub fn new(node: NodeId, heartbeat_period: Duration) -> Master {
+    pub fn new(node: NodeId, heartbeat_period: Option<Duration>) -> Master {
         Master {
             nmt: NmtMaster::new(),
             heartbeat: HeartbeatProducer::new(node, heartbeat_period),

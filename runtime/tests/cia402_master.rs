@@ -64,7 +64,7 @@ impl Rig {
             };
             blocking::serve(&mut port, &clock, &mut node, &halt, None, |()| {}).unwrap();
         });
-        let core = master::Master::new(NodeId::new(1).unwrap(), Duration::ZERO);
+        let core = master::Master::new(NodeId::new(1).unwrap(), None);
         let mut master = Master::with_clock(bus.attach(), core, clock);
         master.start().unwrap();
         let monitor = bus.attach();

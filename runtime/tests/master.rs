@@ -158,7 +158,7 @@ impl Rig {
                     SlowStore(store),
                 ),
                 nmt: NmtSlave::new(id),
-                heartbeat: HeartbeatProducer::new(id, Duration::from_millis(50)),
+                heartbeat: HeartbeatProducer::new(id, Some(Duration::from_millis(50))),
             };
             let clock = Clock::new();
             device.nmt.boot_complete();
@@ -167,7 +167,7 @@ impl Rig {
             blocking::serve(&mut port, &clock, &mut device, &halt, None, |()| {}).unwrap();
         }));
 
-        let mut core = master::Master::new(node(1), PERIOD);
+        let mut core = master::Master::new(node(1), Some(PERIOD));
         core.consumer
             .monitor(node(DEVICE), Duration::from_millis(200));
         let mut master = Master::new(master_port, core);

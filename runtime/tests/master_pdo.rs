@@ -74,7 +74,7 @@ impl od::Pdo for Fifth {
 fn rig(configure: impl FnOnce(&mut master::Master)) -> (Master<VirtualPort>, VirtualPort) {
     let bus = VirtualBus::new();
     let device = bus.attach();
-    let mut core = master::Master::new(node(1), Duration::ZERO);
+    let mut core = master::Master::new(node(1), None);
     configure(&mut core);
     let mut m = Master::new(bus.attach(), core);
     m.start().unwrap();

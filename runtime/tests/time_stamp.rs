@@ -113,7 +113,7 @@ proptest! {
             0..32)
     ) {
         let mut consumer = TimeConsumer::new();
-        let mut master = Master::new(NodeId::new(1).unwrap(), Duration::ZERO);
+        let mut master = Master::new(NodeId::new(1).unwrap(), None);
         master.start(Instant::ZERO);
         while master.poll_transmit().is_some() {}
         for (i, (id, extended, remote, data)) in frames.iter().enumerate() {

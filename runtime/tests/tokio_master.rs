@@ -264,7 +264,7 @@ async fn the_driver_ends_with_the_last_handle_and_calls_fail_after_it_stopped() 
 
     // A driver dropped without running: calls fail at once.
     let bus = VirtualBus::new();
-    let core = master::Master::new(node(1), Duration::ZERO);
+    let core = master::Master::new(node(1), None);
     let (master, driver): (Master, Driver<VirtualPort>) = Master::new(bus.attach(), core);
     drop(driver);
     assert!(!master.is_running());
@@ -283,7 +283,7 @@ fn futures_are_send() {
         .unwrap();
     let _guard = rt.enter();
     let bus = VirtualBus::new();
-    let core = master::Master::new(node(1), Duration::ZERO);
+    let core = master::Master::new(node(1), None);
     let (m, driver) = Master::new(bus.attach(), core);
     assert_send(&m.read::<ProducerHeartbeatTime>(node(DEVICE)));
     assert_send(&m.upload(node(DEVICE), 0x1000, 0));

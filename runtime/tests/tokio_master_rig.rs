@@ -118,7 +118,7 @@ impl Device {
         Device {
             sdo: SdoServer::new(ServerConfig::new(Channel::default_for(id)), store),
             nmt: NmtSlave::new(id),
-            heartbeat: HeartbeatProducer::new(id, Duration::from_millis(50)),
+            heartbeat: HeartbeatProducer::new(id, Some(Duration::from_millis(50))),
             lss: LssSlave::new(IDENTITY, Some(id), BitTiming::standard(BitRate::Kbit500)),
             tpdo,
             counter: 0,
@@ -202,7 +202,7 @@ impl Rig {
         let bus = VirtualBus::new();
         let monitor = bus.attach();
         let device = spawn_device(bus.attach());
-        let mut core = master::Master::new(node(1), Duration::from_millis(100));
+        let mut core = master::Master::new(node(1), Some(Duration::from_millis(100)));
         configure(&mut core);
         let (master, driver) = Master::new(bus.attach(), core);
         let events = master.events();

@@ -105,7 +105,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<Summary> {
         )
     })?;
     let me = NodeId::new(MASTER_NODE).ok_or_else(|| ScenarioError("master node id".into()))?;
-    let mut core = master::Master::new(me, MASTER_HEARTBEAT);
+    let mut core = master::Master::new(me, Some(MASTER_HEARTBEAT));
     core.heartbeat.set_state(NmtState::Operational);
     let mut m = Master::with_clock(harness.take_port()?, core, harness.clock());
     // A stroke takes about 10 s at 5 mm/s; a real actuator may be longer

@@ -101,7 +101,7 @@ pub fn run(args: &Args, out: &mut dyn std::io::Write) -> Result<Summary, Box<dyn
         zimmer_acs::simulator_with(model, zimmer_acs::default_config(), now)
     })?;
     let me = NodeId::new(MASTER_NODE).ok_or_else(|| fail("bad master node id".into()))?;
-    let core = master::Master::new(me, Duration::ZERO);
+    let core = master::Master::new(me, None);
     let mut session = Session {
         master: blocking::Master::with_clock(harness.take_port()?, core, harness.clock()),
         drive: Drive::new(DriveConfig::default()),

@@ -218,8 +218,8 @@ impl<B: Behaviour> Device<B> {
             self.server.set_extra_channels(Vec::new());
             return;
         };
-        let period = d.table.get_uint(0x1017, 0).unwrap_or(0);
-        let mut producer = HeartbeatProducer::new(node, Duration::from_millis(period));
+        let ms = d.table.get_uint(0x1017, 0).unwrap_or(0);
+        let mut producer = HeartbeatProducer::new(node, producer_time(ms));
         producer.start(now);
         self.heartbeat = Some(producer);
         self.configure_consumer();
@@ -364,7 +364,7 @@ impl<B: Behaviour> Device<B> {
                 0x1017 => {
                     let ms = self.table().get_uint(0x1017, 0).unwrap_or(0);
                     if let Some(hb) = self.heartbeat.as_mut() {
-                        hb.set_period(now, Duration::from_millis(ms));
+                        hb.set_period(now, producer_time(ms));
                     }
                 }
                 0x1016 => self.configure_consumer(),
@@ -519,4 +519,9 @@ fn server_config(node: Option<NodeId>) -> ServerConfig {
         None => Channel::standard(0x600, 0x580),
     };
     ServerConfig::new(channel)
+}
+
+/// The heartbeat period of object 0x1017's value in ms (0: none).
+fn producer_time(ms: u64) -> Option<Duration> {
+    (ms != 0).then(|| Duration::from_millis(ms))
 }

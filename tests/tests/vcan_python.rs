@@ -364,7 +364,7 @@ fn python_nmt_master_commands_our_slave() {
         let mut nmt = NmtSlave::new(node);
         nmt.boot_complete();
         while nmt.poll_event().is_some() {}
-        let mut heartbeat = HeartbeatProducer::new(node, Duration::from_millis(100));
+        let mut heartbeat = HeartbeatProducer::new(node, Some(Duration::from_millis(100)));
         heartbeat.set_state(nmt.state());
         heartbeat.start(clock.now());
         let mut device = Device { nmt, heartbeat };

@@ -48,7 +48,7 @@ fn next_status(m: &mut Master<MasterPort>, node: NodeId) -> Result<Tpdo1Status> 
 fn boots_answers_sdo_and_sends_its_tpdo() -> Result {
     let drive = node(conveyor::DEFAULT_NODE_ID);
     let mut harness = Harness::start(&Args::default(), |now| sim_device::simulator(drive, now))?;
-    let mut core = master::Master::new(node(1), Duration::ZERO);
+    let mut core = master::Master::new(node(1), None);
     core.pdo_rx.watch_pdo::<Tpdo1Status>(drive)?;
     let mut m = Master::with_clock(harness.take_port()?, core, harness.clock());
     m.start()?;

@@ -51,7 +51,7 @@ pub const MASTER_QUEUE_CAPACITY: usize = 1024;
 ///
 /// let bus = VirtualBus::new();
 /// let monitor = bus.attach();
-/// let core = master::Master::new(NodeId::new(1).unwrap(), Duration::from_millis(100));
+/// let core = master::Master::new(NodeId::new(1).unwrap(), Some(Duration::from_millis(100)));
 /// let mut m = Master::new(bus.attach(), core);
 /// m.start()?; // boot-up message of node 1
 /// m.nmt(NmtCommand::Start, NodeId::new(0x20))?;

@@ -32,7 +32,7 @@ fn drain_events(master: &mut Master) -> Vec<MasterEvent> {
 
 #[test]
 fn frames_come_from_the_cores_in_turn_each_in_its_own_order() {
-    let mut m = Master::new(node(1), Duration::from_millis(100));
+    let mut m = Master::new(node(1), Some(Duration::from_millis(100)));
     m.add_sdo_client(node(5), ClientConfig::new(Channel::default_for(node(5))));
     m.start(ms(0));
     m.nmt.send(NmtCommand::ResetCommunication, None).unwrap();
@@ -62,7 +62,7 @@ fn frames_come_from_the_cores_in_turn_each_in_its_own_order() {
 
 #[test]
 fn own_sync_drives_the_synchronous_rpdos_and_is_reported_on_request() {
-    let mut m = Master::new(node(1), Duration::ZERO);
+    let mut m = Master::new(node(1), None);
     m.sync = Some(SyncProducer::new(Duration::from_millis(10), Some(2)).unwrap());
     // RPDO1 of node 5, synchronous cyclic every SYNC.
     let i = m
@@ -93,7 +93,7 @@ fn own_sync_drives_the_synchronous_rpdos_and_is_reported_on_request() {
 
 #[test]
 fn the_deadline_is_the_earliest_of_all_cores_and_only_due_cores_run() {
-    let mut m = Master::new(node(1), Duration::from_millis(100));
+    let mut m = Master::new(node(1), Some(Duration::from_millis(100)));
     m.sync = Some(SyncProducer::new(Duration::from_millis(30), None).unwrap());
     let mut config = ClientConfig::new(Channel::default_for(node(5)));
     config.timeout = Duration::from_millis(50);
@@ -129,7 +129,7 @@ fn the_deadline_is_the_earliest_of_all_cores_and_only_due_cores_run() {
 
 #[test]
 fn every_core_sees_every_frame() {
-    let mut m = Master::new(node(1), Duration::ZERO);
+    let mut m = Master::new(node(1), None);
     m.consumer.monitor(node(5), Duration::from_millis(500));
     m.pdo_rx.watch(PdoCobId(0x185), 2, None).unwrap();
     m.add_sdo_client(node(5), ClientConfig::new(Channel::default_for(node(5))));
@@ -193,7 +193,7 @@ fn every_core_sees_every_frame() {
 
 #[test]
 fn sdo_clients_are_kept_per_node() {
-    let mut m = Master::new(node(1), Duration::ZERO);
+    let mut m = Master::new(node(1), None);
     assert!(m.sdo(node(7)).is_none());
     assert_eq!(
         m.sdo_or_default(node(7)).config().channel,
@@ -212,7 +212,7 @@ fn sdo_clients_are_kept_per_node() {
 #[test]
 fn time_frames_become_events_and_the_master_can_produce_time() {
     use crate::time_stamp::{DateTime, TimeError, TimeEvent, TimeOfDay, TimeProducer};
-    let mut m = Master::new(node(1), Duration::ZERO);
+    let mut m = Master::new(node(1), None);
     m.start(ms(0));
     drain_frames(&mut m);
     // 2026-12-02T12:34:56.789Z: 45_296_789 ms = 0x02B3_2C95, day 15_676 =
@@ -252,7 +252,7 @@ fn time_frames_become_events_and_the_master_can_produce_time() {
     assert_eq!(drain_events(&mut m), []);
 
     // A TIME producer every second, from the start.
-    let mut m = Master::new(node(1), Duration::ZERO);
+    let mut m = Master::new(node(1), None);
     let mut producer = TimeProducer::new(Duration::from_secs(1));
     producer.set_time(ms(0), time);
     m.time_tx = Some(producer);

@@ -99,7 +99,7 @@ use stream::Queue;
 /// # async fn main() -> std::io::Result<()> {
 /// let bus = VirtualBus::new();
 /// let monitor = bus.attach();
-/// let core = master::Master::new(NodeId::new(1).unwrap(), Duration::from_millis(100));
+/// let core = master::Master::new(NodeId::new(1).unwrap(), Some(Duration::from_millis(100)));
 /// let (m, driver) = Master::new(bus.attach(), core);
 /// let driver = tokio::spawn(driver.run());
 /// m.start().await?; // boot-up message of node 1

@@ -514,8 +514,9 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
             }
         }
     } else {
-        let doc =
-            format!(" The default COB-ID entry value, {text} (bit 31 set means the PDO is disabled).");
+        let doc = format!(
+            " The default COB-ID entry value, {text} (bit 31 set means the PDO is disabled)."
+        );
         quote! {
             #[doc = #doc]
             pub const COB_ID: #rt::od::standard::PdoCobId = #rt::od::standard::PdoCobId::from_raw(#value_lit);

@@ -114,7 +114,7 @@ impl<B: Bus> Master<B> {
     ///     ObjectInfo::new(0x6041, 0, "Statusword", DataType::Unsigned16, AccessRight::Ro, true),
     /// ];
     /// # let bus = VirtualBus::new();
-    /// # let core = master::Master::new(NodeId::new(1).unwrap(), Duration::from_millis(100));
+    /// # let core = master::Master::new(NodeId::new(1).unwrap(), Some(Duration::from_millis(100)));
     /// let mut m = Master::new(bus.attach(), core);
     /// let node = NodeId::new(0x20).unwrap();
     /// let config = SessionConfig { required: &[Operation::ProfileVelocity], ..SessionConfig::default() };
