@@ -85,7 +85,7 @@ impl HeartbeatProducer {
     pub const fn new(node: NodeId, period: Option<Duration>) -> HeartbeatProducer {
         HeartbeatProducer {
             node,
-            period: at_least_1_ms(period),
+            period: at_least(period, MIN_PERIOD),
             state: NmtState::PreOperational,
             running: false,
             next: None,
@@ -140,7 +140,7 @@ impl HeartbeatProducer {
     /// next heartbeat is due one new period after `now` (`None` stops the
     /// heartbeats, a later period starts them again).
     pub fn set_period(&mut self, now: Instant, period: Option<Duration>) {
-        self.period = at_least_1_ms(period);
+        self.period = at_least(period, MIN_PERIOD);
         if self.is_running() {
             self.next = self.schedule(now);
         }
@@ -151,12 +151,15 @@ impl HeartbeatProducer {
     }
 }
 
-/// `period` raised to 1 ms, the unit of object 0x1017 (a shorter one would
-/// be due again at once).
-const fn at_least_1_ms(period: Option<Duration>) -> Option<Duration> {
-    const MS: Duration = Duration::from_millis(1);
+/// The shortest heartbeat period: 1 ms, the unit of object 0x1017.
+const MIN_PERIOD: Duration = Duration::from_millis(1);
+
+/// A producer's period raised to `min` (a zero one would be due again at
+/// once, for ever): what the producers do with a `Some` period shorter than
+/// the unit of their object.
+pub(crate) const fn at_least(period: Option<Duration>, min: Duration) -> Option<Duration> {
     match period {
-        Some(p) if p.as_nanos() < MS.as_nanos() => Some(MS),
+        Some(p) if p.as_nanos() < min.as_nanos() => Some(min),
         other => other,
     }
 }

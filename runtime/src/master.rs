@@ -30,7 +30,7 @@
 //! let me = NodeId::new(1).unwrap();
 //! let drive = NodeId::new(5).unwrap();
 //! let mut master = Master::new(me, Some(Duration::from_millis(100)));
-//! master.sync = Some(SyncProducer::new(Duration::from_millis(10), None).unwrap());
+//! master.sync = Some(SyncProducer::new(Some(Duration::from_millis(10)), None).unwrap());
 //! master.add_sdo_client(drive, ClientConfig::new(Channel::default_for(drive)));
 //! master.start(Instant::ZERO);
 //!

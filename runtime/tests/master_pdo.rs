@@ -110,7 +110,7 @@ fn send_pdo_sets_a_synchronous_transmitter_sent_at_its_sync() {
             TransmissionType::SynchronousAcyclic,
         ))
         .unwrap();
-        core.sync = Some(SyncProducer::new(Duration::from_millis(5), None).unwrap());
+        core.sync = Some(SyncProducer::new(Some(Duration::from_millis(5)), None).unwrap());
     });
     m.send_pdo(node(DEVICE), &Command(7)).unwrap();
     assert_eq!(device.try_recv(), None, "a synchronous PDO waits for SYNC");

@@ -462,7 +462,7 @@ fn master_and_device_exchange_pdos_paced_by_sync() {
         .unwrap();
     let mut device_rx = PdoReceiver::new();
     device_rx.watch(PdoCobId(0x205), 2, None).unwrap();
-    let mut sync = SyncProducer::new(Duration::from_millis(10), None).unwrap();
+    let mut sync = SyncProducer::new(Some(Duration::from_millis(10)), None).unwrap();
     sync.start(Instant::ZERO);
     master_tx.set_data(Instant::ZERO, &[0x0F, 0x00]).unwrap();
     let mut net = Network {

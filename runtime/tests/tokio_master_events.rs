@@ -94,7 +94,7 @@ async fn emcy_and_nmt_events_and_command_frames() {
 #[tokio::test(start_paused = true)]
 async fn pdo_stream_yields_decoded_values() {
     let rig = Rig::new(|core| {
-        core.sync = Some(SyncProducer::new(Duration::from_millis(10), None).unwrap());
+        core.sync = Some(SyncProducer::new(Some(Duration::from_millis(10)), None).unwrap());
     })
     .await;
     let mut pdos = rig.master.pdos::<Counter>(node(DEVICE)).unwrap();

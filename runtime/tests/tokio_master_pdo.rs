@@ -62,7 +62,7 @@ async fn send_pdo_sends_the_typed_rpdo() {
 #[tokio::test(start_paused = true)]
 async fn next_pdo_and_latest_pdo_receive_the_typed_tpdo() {
     let rig = Rig::new(|core| {
-        core.sync = Some(SyncProducer::new(Duration::from_millis(10), None).unwrap());
+        core.sync = Some(SyncProducer::new(Some(Duration::from_millis(10)), None).unwrap());
     })
     .await;
     assert!(

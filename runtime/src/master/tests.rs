@@ -63,7 +63,7 @@ fn frames_come_from_the_cores_in_turn_each_in_its_own_order() {
 #[test]
 fn own_sync_drives_the_synchronous_rpdos_and_is_reported_on_request() {
     let mut m = Master::new(node(1), None);
-    m.sync = Some(SyncProducer::new(Duration::from_millis(10), Some(2)).unwrap());
+    m.sync = Some(SyncProducer::new(Some(Duration::from_millis(10)), Some(2)).unwrap());
     // RPDO1 of node 5, synchronous cyclic every SYNC.
     let i = m
         .add_pdo_tx(TransmitterConfig::new(
@@ -94,7 +94,7 @@ fn own_sync_drives_the_synchronous_rpdos_and_is_reported_on_request() {
 #[test]
 fn the_deadline_is_the_earliest_of_all_cores_and_only_due_cores_run() {
     let mut m = Master::new(node(1), Some(Duration::from_millis(100)));
-    m.sync = Some(SyncProducer::new(Duration::from_millis(30), None).unwrap());
+    m.sync = Some(SyncProducer::new(Some(Duration::from_millis(30)), None).unwrap());
     let mut config = ClientConfig::new(Channel::default_for(node(5)));
     config.timeout = Duration::from_millis(50);
     m.add_sdo_client(node(5), config);
@@ -253,7 +253,7 @@ fn time_frames_become_events_and_the_master_can_produce_time() {
 
     // A TIME producer every second, from the start.
     let mut m = Master::new(node(1), None);
-    let mut producer = TimeProducer::new(Duration::from_secs(1));
+    let mut producer = TimeProducer::new(Some(Duration::from_secs(1)));
     producer.set_time(ms(0), time);
     m.time_tx = Some(producer);
     m.start(ms(0));
