@@ -279,7 +279,7 @@ mod tests {
         assert!(!cob.is_valid() && cob.rtr_allowed() && !cob.is_extended());
         assert_eq!(cob.can_id(), CanId::Standard(0x185));
         assert_eq!(cob.with_valid(true).to_raw(), 0x185);
-        assert_eq!(PdoCobId::from_raw(0x4000_0000).rtr_allowed(), false);
+        assert!(!PdoCobId::from_raw(0x4000_0000).rtr_allowed());
         assert_eq!(
             <PdoCobId as Scalar>::from_raw(0x4000_0000).to_raw(),
             0x4000_0000
