@@ -9,7 +9,8 @@ use std::sync::Arc;
 
 use eds2rust::ir::pdo::MappedObject;
 use eds2rust::ir::{DataType, PdoDirection, Semantics, ValueKind};
-use eds2rust_runtime::pdo::layout;
+use eds2rust_runtime::CanId;
+use eds2rust_runtime::pdo::{PdoCobId, layout};
 
 use crate::dictionary::{Dictionary, comm_index, mapping_index};
 
@@ -52,7 +53,7 @@ pub enum Raw {
 /// The configuration of one PDO: its COB-ID entry and mapping entries.
 #[derive(Debug, Clone, Default)]
 struct PdoParams {
-    cob_id: Option<u32>,
+    cob_id: Option<PdoCobId>,
     count: Option<u8>,
     entries: BTreeMap<u8, u32>,
 }
@@ -61,8 +62,9 @@ struct PdoParams {
 #[derive(Debug, Default)]
 pub struct PdoTable {
     params: BTreeMap<(u8, PdoDirection, u16), PdoParams>,
-    /// Valid COB-ID (11 or 29 bits) → the PDO's layout; rebuilt on change.
-    by_cob: HashMap<u32, Arc<PdoLayout>>,
+    /// The identifier of a valid COB-ID → the PDO's layout; rebuilt on
+    /// change.
+    by_cob: HashMap<CanId, Arc<PdoLayout>>,
     dirty: bool,
 }
 
@@ -73,7 +75,7 @@ impl PdoTable {
             let comm = comm_index(direction, number);
             let map = mapping_index(direction, number);
             let mut p = PdoParams {
-                cob_id: dict.initial_u32(comm, 1),
+                cob_id: dict.initial_u32(comm, 1).map(PdoCobId),
                 count: dict.initial_u32(map, 0).and_then(|c| u8::try_from(c).ok()),
                 entries: BTreeMap::new(),
             };
@@ -93,7 +95,7 @@ impl PdoTable {
         let (direction, number, mapping) = pdo;
         let p = self.params.entry((node, direction, number)).or_default();
         match (mapping, sub) {
-            (false, 1) => p.cob_id = Some(value),
+            (false, 1) => p.cob_id = Some(PdoCobId(value)),
             (true, 0) => p.count = u8::try_from(value).ok(),
             (true, 1..=64) => {
                 p.entries.insert(sub, value);
@@ -115,7 +117,11 @@ impl PdoTable {
         if self.dirty {
             self.rebuild(dicts);
         }
-        let key = if extended { id | 1 << 29 } else { id };
+        let key = if extended {
+            CanId::extended(id)?
+        } else {
+            CanId::standard(u16::try_from(id).ok()?)?
+        };
         self.by_cob.get(&key).cloned()
     }
 
@@ -124,15 +130,10 @@ impl PdoTable {
         for (&(node, direction, number), p) in &self.params {
             let Some(cob) = p.cob_id else { continue };
             // Bit 31 set: the PDO is not valid (no frames are expected).
-            if cob & 1 << 31 != 0 {
+            if !cob.is_valid() {
                 continue;
             }
-            let extended = cob & 1 << 29 != 0;
-            let key = if extended {
-                cob & 0x1FFF_FFFF | 1 << 29
-            } else {
-                cob & 0x7FF
-            };
+            let key = cob.can_id();
             let Some(dict) = dicts.get(&node) else {
                 continue;
             };

@@ -115,16 +115,16 @@ pub(crate) fn expand(pdo: &Pdo) -> TokenStream {
         quote! {
             #[doc = #doc]
             #[inline]
-            pub const fn cob_id(node_id: #rt::od::NodeId) -> u32 {
+            pub const fn cob_id(node_id: #rt::od::NodeId) -> #rt::od::standard::PdoCobId {
                 match #rt::pdo::derive::predefined_cob_id(#tpdo, #number, node_id.get()) {
                     ::core::option::Option::Some(id) => id,
-                    ::core::option::Option::None => 0,
+                    ::core::option::Option::None => #rt::od::standard::PdoCobId::from_raw(0),
                 }
             }
             #[doc = " The CAN identifier of [`Self::cob_id`]."]
             #[inline]
-            pub const fn can_id(node_id: #rt::od::NodeId) -> u32 {
-                Self::cob_id(node_id) & 0x7FF
+            pub const fn can_id(node_id: #rt::od::NodeId) -> #rt::CanId {
+                Self::cob_id(node_id).can_id()
             }
         }
     } else {
@@ -174,7 +174,9 @@ pub(crate) fn expand(pdo: &Pdo) -> TokenStream {
             const LEN: usize = #name::LEN;
             const MAPPING: &'static [u32] = &#name::__PDO_MAPPING;
             #[inline]
-            fn default_cob_id(node_id: #rt::od::NodeId) -> ::core::option::Option<u32> {
+            fn default_cob_id(
+                node_id: #rt::od::NodeId,
+            ) -> ::core::option::Option<#rt::od::standard::PdoCobId> {
                 #rt::pdo::derive::predefined_cob_id(#tpdo, #number, node_id.get())
             }
             #[inline]

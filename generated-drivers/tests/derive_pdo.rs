@@ -5,8 +5,9 @@
 //! order from bit 0).
 
 use eds2rust_drivers::interroll_ec5000bi::od;
-use eds2rust_runtime::Pdo;
 use eds2rust_runtime::od::{Entry, NodeId, Pdo as _, PdoDirection, PdoLengthError, Scalar};
+use eds2rust_runtime::pdo::PdoCobId;
+use eds2rust_runtime::{CanId, Pdo};
 
 #[derive(Pdo, Debug, Clone, Copy, PartialEq)]
 #[pdo(tpdo = 2)]
@@ -58,9 +59,10 @@ fn layout_mapping_and_cob_ids() {
         (0x1801, 0x1A01)
     );
     let node = NodeId::new(5).unwrap();
-    assert_eq!(StatusPosition::cob_id(node), 0x285);
-    assert_eq!(StatusPosition::default_cob_id(node), Some(0x285));
-    assert_eq!(ControlVelocity::cob_id(node), 0x205);
+    assert_eq!(StatusPosition::cob_id(node), PdoCobId(0x285));
+    assert_eq!(StatusPosition::can_id(node), CanId::Standard(0x285));
+    assert_eq!(StatusPosition::default_cob_id(node), Some(PdoCobId(0x285)));
+    assert_eq!(ControlVelocity::cob_id(node), PdoCobId(0x205));
     assert_eq!(ControlVelocity::MAPPING, [0x6040_0010, 0x60FF_0020]);
     assert_eq!(ControlVelocity::LEN, 6);
     // Above 4 there is no predefined COB-ID.

@@ -3,7 +3,9 @@
 //! manual states, and the commands encode to the frames it shows.
 
 use eds2rust_drivers::linak_techline::{self as linak, errors::LinakErrors, od, pdo};
+use eds2rust_runtime::CanId;
 use eds2rust_runtime::od::{NodeId, PdoLengthError};
+use eds2rust_runtime::pdo::PdoCobId;
 
 fn node32() -> NodeId {
     NodeId::new(linak::DEFAULT_NODE_ID).expect("32 is a node id")
@@ -30,8 +32,8 @@ fn speed_mm_s(s: od::feedback::SpeedValue) -> f64 {
 
 #[test]
 fn cob_ids_of_node_32_are_the_traces() {
-    assert_eq!(pdo::Tpdo1Feedback::can_id(node32()), 0x1A0);
-    assert_eq!(pdo::Rpdo1Command::can_id(node32()), 0x220);
+    assert_eq!(pdo::Tpdo1Feedback::can_id(node32()), CanId::Standard(0x1A0));
+    assert_eq!(pdo::Rpdo1Command::can_id(node32()), CanId::Standard(0x220));
     assert_eq!(linak::DEFAULT_BIT_RATE_KBIT, 250);
     // $NODEID-relative defaults of other entries: EMCY and the SDO server.
     assert_eq!(od::CobIdEmcy::default_for(node32()).to_raw(), 0xA0);
@@ -63,12 +65,12 @@ fn pdo_mappings_are_the_manuals() {
     );
     assert_eq!(
         <pdo::Tpdo1Feedback as Pdo>::default_cob_id(node32()),
-        Some(0x1A0)
+        Some(PdoCobId(0x1A0))
     );
     assert_eq!(<pdo::Rpdo1Command as Pdo>::MAPPING.len(), 7);
     assert_eq!(
         <pdo::Rpdo1Command as Pdo>::default_cob_id(node32()),
-        Some(0x220)
+        Some(PdoCobId(0x220))
     );
 }
 

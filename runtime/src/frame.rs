@@ -5,10 +5,14 @@ use core::fmt;
 
 use crate::od::NodeId;
 
-/// A CAN identifier: 11-bit standard (what CANopen uses) or 29-bit extended.
+/// A CAN identifier, the identifier of a frame on the bus: 11-bit
+/// standard (what CANopen uses) or 29-bit extended. A PDO's COB-ID entry,
+/// which adds the valid and RTR bits, is [`crate::od::standard::PdoCobId`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum CanId {
+    /// An 11-bit identifier (0 to 0x7FF).
     Standard(u16),
+    /// A 29-bit identifier (0 to 0x1FFF_FFFF).
     Extended(u32),
 }
 
@@ -36,6 +40,16 @@ impl CanId {
         match self {
             CanId::Standard(id) => id as u32,
             CanId::Extended(id) => id,
+        }
+    }
+}
+
+/// `0x185` (standard, 3 hex digits) or `0x00000185` (extended, 8).
+impl fmt::Display for CanId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CanId::Standard(id) => write!(f, "{id:#05X}"),
+            CanId::Extended(id) => write!(f, "{id:#010X}"),
         }
     }
 }

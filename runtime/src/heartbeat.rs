@@ -60,8 +60,9 @@ pub(crate) fn next_period(due: Instant, now: Instant, period: Duration) -> Insta
 /// Heartbeat producer of one node (object 0x1017). After
 /// [`HeartbeatProducer::start`] it sends the boot-up message, then a
 /// heartbeat with the current state every period (the first one period after
-/// the start). A period of zero disables heartbeats (the boot-up message is
-/// still sent).
+/// the start). Without a period (`None`) no heartbeats are sent (the
+/// boot-up message still is). A period below 1 ms, the unit of object
+/// 0x1017, counts as 1 ms.
 ///
 /// Frames are built when polled: at most one boot-up and one heartbeat are
 /// pending; a heartbeat due while the previous one was not yet polled is
@@ -70,7 +71,7 @@ pub(crate) fn next_period(due: Instant, now: Instant, period: Duration) -> Insta
 #[derive(Debug, Clone)]
 pub struct HeartbeatProducer {
     node: NodeId,
-    period: Duration,
+    period: Option<Duration>,
     state: NmtState,
     running: bool,
     next: Option<Instant>,
@@ -81,10 +82,10 @@ pub struct HeartbeatProducer {
 impl HeartbeatProducer {
     /// A stopped producer for `node` reporting [`NmtState::PreOperational`]
     /// (the state a node enters after boot-up).
-    pub const fn new(node: NodeId, period: Duration) -> HeartbeatProducer {
+    pub const fn new(node: NodeId, period: Option<Duration>) -> HeartbeatProducer {
         HeartbeatProducer {
             node,
-            period,
+            period: at_least(period, MIN_PERIOD),
             state: NmtState::PreOperational,
             running: false,
             next: None,
@@ -98,8 +99,8 @@ impl HeartbeatProducer {
         self.node
     }
 
-    /// The producer time (zero: disabled).
-    pub const fn period(&self) -> Duration {
+    /// The producer time (`None`: no heartbeats).
+    pub const fn period(&self) -> Option<Duration> {
         self.period
     }
 
@@ -136,17 +137,30 @@ impl HeartbeatProducer {
     }
 
     /// Changes the producer time (object 0x1017 written); when running, the
-    /// next heartbeat is due one new period after `now` (zero disables
-    /// heartbeats, a later non-zero period enables them again).
-    pub fn set_period(&mut self, now: Instant, period: Duration) {
-        self.period = period;
+    /// next heartbeat is due one new period after `now` (`None` stops the
+    /// heartbeats, a later period starts them again).
+    pub fn set_period(&mut self, now: Instant, period: Option<Duration>) {
+        self.period = at_least(period, MIN_PERIOD);
         if self.is_running() {
             self.next = self.schedule(now);
         }
     }
 
     fn schedule(&self, now: Instant) -> Option<Instant> {
-        (!self.period.is_zero()).then(|| now + self.period)
+        self.period.map(|period| now + period)
+    }
+}
+
+/// The shortest heartbeat period: 1 ms, the unit of object 0x1017.
+const MIN_PERIOD: Duration = Duration::from_millis(1);
+
+/// A producer's period raised to `min` (a zero one would be due again at
+/// once, for ever): what the producers do with a `Some` period shorter than
+/// the unit of their object.
+pub(crate) const fn at_least(period: Option<Duration>, min: Duration) -> Option<Duration> {
+    match period {
+        Some(p) if p.as_nanos() < min.as_nanos() => Some(min),
+        other => other,
     }
 }
 
@@ -161,7 +175,7 @@ impl Service for HeartbeatProducer {
             && due <= now
         {
             self.heartbeat_pending = true;
-            self.next = Some(next_period(due, now, self.period));
+            self.next = self.period.map(|period| next_period(due, now, period));
         }
     }
 
@@ -426,7 +440,7 @@ mod tests {
 
     #[test]
     fn producer_sends_boot_up_then_periodic_heartbeats() {
-        let mut p = HeartbeatProducer::new(node(32), Duration::from_millis(100));
+        let mut p = HeartbeatProducer::new(node(32), Some(Duration::from_millis(100)));
         assert_eq!(p.poll_timeout(), None);
         assert!(frames(&mut p).is_empty());
         p.start(ms(1000));
@@ -446,7 +460,7 @@ mod tests {
 
     #[test]
     fn producer_big_time_jump_sends_one_frame() {
-        let mut p = HeartbeatProducer::new(node(5), Duration::from_millis(10));
+        let mut p = HeartbeatProducer::new(node(5), Some(Duration::from_millis(10)));
         p.start(ms(0));
         frames(&mut p);
         p.handle_timeout(ms(60_000));
@@ -456,13 +470,13 @@ mod tests {
 
     #[test]
     fn producer_zero_period_and_period_changes() {
-        let mut p = HeartbeatProducer::new(node(5), Duration::ZERO);
+        let mut p = HeartbeatProducer::new(node(5), None);
         p.start(ms(0));
         assert_eq!(p.poll_timeout(), None);
         assert_eq!(frames(&mut p), [data(0x705, &[0x00])]);
         assert!(p.is_running());
         // Enabled later (0x1017 written while running).
-        p.set_period(ms(70), Duration::from_millis(20));
+        p.set_period(ms(70), Some(Duration::from_millis(20)));
         assert_eq!(p.poll_timeout(), Some(ms(90)));
         p.handle_timeout(ms(90));
         p.stop();
@@ -470,7 +484,11 @@ mod tests {
         assert_eq!(p.poll_timeout(), None);
         assert!(frames(&mut p).is_empty());
         // Not started: a period change schedules nothing.
-        p.set_period(ms(100), Duration::from_millis(20));
+        p.set_period(ms(100), Some(Duration::from_millis(20)));
+        assert_eq!(p.poll_timeout(), None);
+        // A period below 1 ms counts as 1 ms.
+        p.set_period(ms(100), Some(Duration::from_micros(10)));
+        assert_eq!(p.period(), Some(Duration::from_millis(1)));
         assert_eq!(p.poll_timeout(), None);
     }
 
@@ -546,7 +564,7 @@ mod tests {
 
     #[test]
     fn producer_feeds_consumer() {
-        let mut p = HeartbeatProducer::new(node(32), Duration::from_millis(100));
+        let mut p = HeartbeatProducer::new(node(32), Some(Duration::from_millis(100)));
         let mut c = HeartbeatConsumer::new();
         c.monitor(node(32), Duration::from_millis(150));
         p.start(ms(0));

@@ -29,8 +29,8 @@
 //!
 //! let me = NodeId::new(1).unwrap();
 //! let drive = NodeId::new(5).unwrap();
-//! let mut master = Master::new(me, Duration::from_millis(100));
-//! master.sync = Some(SyncProducer::new(Duration::from_millis(10), None).unwrap());
+//! let mut master = Master::new(me, Some(Duration::from_millis(100)));
+//! master.sync = Some(SyncProducer::new(Some(Duration::from_millis(10)), None).unwrap());
 //! master.add_sdo_client(drive, ClientConfig::new(Channel::default_for(drive)));
 //! master.start(Instant::ZERO);
 //!
@@ -53,9 +53,11 @@ use crate::emcy::{EmcyConsumer, EmcyEvent};
 use crate::heartbeat::{HeartbeatConsumer, HeartbeatEvent, HeartbeatProducer};
 use crate::lss::{LssEvent, LssMaster};
 use crate::nmt::{NmtEvent, NmtMaster};
+use crate::od;
 use crate::od::NodeId;
 use crate::pdo::{
-    PdoEvent, PdoReceiver, PdoTransmitter, TransmitterConfig, TransmitterConfigError,
+    PdoCobId, PdoError, PdoEvent, PdoReceiver, PdoTransmitter, TransmissionType, TransmitterConfig,
+    TransmitterConfigError,
 };
 use crate::queue::Ring;
 use crate::sdo::Channel;
@@ -146,10 +148,10 @@ pub struct Master {
 
 impl Master {
     /// A master with node id `node` and heartbeat producer time
-    /// `heartbeat_period` (zero: no heartbeats, only the boot-up message).
+    /// `heartbeat_period` (`None`: no heartbeats, only the boot-up message).
     /// No SYNC, no SDO clients, no PDOs; nothing runs before
     /// [`Master::start`].
-    pub fn new(node: NodeId, heartbeat_period: Duration) -> Master {
+    pub fn new(node: NodeId, heartbeat_period: Option<Duration>) -> Master {
         Master {
             nmt: NmtMaster::new(),
             heartbeat: HeartbeatProducer::new(node, heartbeat_period),
@@ -237,6 +239,46 @@ impl Master {
     ) -> Result<usize, TransmitterConfigError> {
         self.pdo_tx.push(PdoTransmitter::new(config)?);
         Ok(self.pdo_tx.len() - 1)
+    }
+
+    /// Sets the data of the RPDO the master sends on `cob_id`'s identifier
+    /// from `pdo` at `now` ([`PdoTransmitter::set`]): an event-driven PDO
+    /// goes out at once (or when its inhibit time ends), a synchronous one
+    /// at its SYNC. When no transmitter sends on that identifier, an
+    /// event-driven one (transmission type 255) is added for it.
+    pub fn set_pdo<P: od::Pdo>(
+        &mut self,
+        now: Instant,
+        cob_id: PdoCobId,
+        pdo: &P,
+    ) -> Result<(), PdoError> {
+        let can_id = cob_id
+            .checked_can_id()
+            .map_err(TransmitterConfigError::from)?;
+        let i = match self.pdo_tx.iter().position(|tx| tx.can_id() == can_id) {
+            Some(i) => i,
+            None => self.add_pdo_tx(TransmitterConfig::new(
+                cob_id,
+                TransmissionType::EventDrivenProfile,
+            ))?,
+        };
+        match self.pdo_tx.get_mut(i) {
+            Some(tx) => Ok(tx.set(now, pdo)?),
+            None => Ok(()),
+        }
+    }
+
+    /// Watches the PDO `P` on `cob_id` with its length [`od::Pdo::LEN`]
+    /// and no reception timeout, unless that identifier is watched already
+    /// (its settings stay); returns the identifier.
+    pub fn watch_pdo<P: od::Pdo>(&mut self, cob_id: PdoCobId) -> Result<crate::CanId, PdoError> {
+        let can_id = cob_id
+            .checked_can_id()
+            .map_err(crate::pdo::WatchError::from)?;
+        if !self.pdo_rx.is_watched(can_id) {
+            self.pdo_rx.watch(cob_id, P::LEN, None)?;
+        }
+        Ok(can_id)
     }
 
     /// Events of SYNC sends dropped because they were not polled in time.

@@ -626,7 +626,7 @@ pub trait Pdo: Sized {
     const MAPPING: &'static [u32];
     /// The COB-ID entry's default for a node (sub 1 of
     /// [`Pdo::COMMUNICATION_INDEX`]), when the source gives one.
-    fn default_cob_id(node_id: NodeId) -> Option<u32>;
+    fn default_cob_id(node_id: NodeId) -> Option<standard::PdoCobId>;
     /// Decodes a frame's data; it must be exactly [`Pdo::LEN`] bytes.
     fn decode(data: &[u8]) -> Result<Self, PdoLengthError>;
     /// Encodes into the first [`Pdo::LEN`] bytes of `out`; returns that length.

@@ -10,9 +10,12 @@ use core::fmt;
 use core::time::Duration;
 
 use crate::frame::cob;
-use crate::heartbeat::next_period;
+use crate::heartbeat::{at_least, next_period};
 use crate::queue::Ring;
 use crate::{Frame, Instant, Service};
+
+/// The shortest SYNC period: 1 µs, the unit of object 0x1006.
+const MIN_PERIOD: Duration = Duration::from_micros(1);
 
 /// The default SYNC COB-ID.
 pub const DEFAULT_COB_ID: u16 = cob::SYNC;
@@ -72,7 +75,9 @@ pub fn parse_sync(frame: &Frame) -> Option<Option<u8>> {
 }
 
 /// SYNC producer. After [`SyncProducer::start`] a SYNC is due every period,
-/// the first one period after the start; a zero period produces nothing.
+/// the first one period after the start; without a period (`None`) it
+/// produces nothing. A period below 1 µs, the unit of object 0x1006,
+/// counts as 1 µs.
 /// Frames are built when polled: a SYNC due while the previous one was not
 /// yet polled is merged with it, so the counter never skips a value. If the
 /// clock jumps over several periods, one SYNC is sent and the next is
@@ -80,7 +85,7 @@ pub fn parse_sync(frame: &Frame) -> Option<Option<u8>> {
 #[derive(Debug, Clone)]
 pub struct SyncProducer {
     cob_id: u16,
-    period: Duration,
+    period: Option<Duration>,
     overflow: Option<u8>,
     counter: u8,
     running: bool,
@@ -91,14 +96,17 @@ pub struct SyncProducer {
 impl SyncProducer {
     /// A stopped producer on COB-ID 0x080 (period: object 0x1006; counter
     /// overflow: object 0x1019, `None` for frames without a counter).
-    pub fn new(period: Duration, counter_overflow: Option<u8>) -> Result<Self, SyncConfigError> {
+    pub fn new(
+        period: Option<Duration>,
+        counter_overflow: Option<u8>,
+    ) -> Result<Self, SyncConfigError> {
         SyncProducer::with_cob_id(DEFAULT_COB_ID, period, counter_overflow)
     }
 
     /// A stopped producer on `cob_id`.
     pub fn with_cob_id(
         cob_id: u16,
-        period: Duration,
+        period: Option<Duration>,
         counter_overflow: Option<u8>,
     ) -> Result<Self, SyncConfigError> {
         if cob_id > 0x7FF {
@@ -111,7 +119,7 @@ impl SyncProducer {
         }
         Ok(SyncProducer {
             cob_id,
-            period,
+            period: at_least(period, MIN_PERIOD),
             overflow: counter_overflow,
             counter: 1,
             running: false,
@@ -125,8 +133,8 @@ impl SyncProducer {
         self.cob_id
     }
 
-    /// The communication cycle period (zero: no SYNC).
-    pub const fn period(&self) -> Duration {
+    /// The communication cycle period (`None`: no SYNC).
+    pub const fn period(&self) -> Option<Duration> {
         self.period
     }
 
@@ -136,7 +144,7 @@ impl SyncProducer {
     }
 
     /// Whether the producer has been started (and not stopped); it sends
-    /// nothing while the period is zero.
+    /// nothing without a period.
     pub const fn is_running(&self) -> bool {
         self.running
     }
@@ -147,7 +155,7 @@ impl SyncProducer {
         self.running = true;
         self.counter = 1;
         self.pending = false;
-        self.next = (!self.period.is_zero()).then(|| now + self.period);
+        self.next = self.period.map(|period| now + period);
     }
 
     /// Stops producing (a pending SYNC is discarded).
@@ -158,12 +166,12 @@ impl SyncProducer {
     }
 
     /// Changes the period (object 0x1006 written); when running, the next
-    /// SYNC is due one new period after `now` (zero pauses the producer, a
-    /// later non-zero period resumes it).
-    pub fn set_period(&mut self, now: Instant, period: Duration) {
-        self.period = period;
+    /// SYNC is due one new period after `now` (`None` pauses the producer,
+    /// a later period resumes it).
+    pub fn set_period(&mut self, now: Instant, period: Option<Duration>) {
+        self.period = at_least(period, MIN_PERIOD);
         if self.is_running() {
-            self.next = (!period.is_zero()).then(|| now + period);
+            self.next = self.period.map(|period| now + period);
         }
     }
 }
@@ -179,7 +187,7 @@ impl Service for SyncProducer {
             && due <= now
         {
             self.pending = true;
-            self.next = Some(next_period(due, now, self.period));
+            self.next = self.period.map(|period| next_period(due, now, period));
         }
     }
 
@@ -326,7 +334,7 @@ mod tests {
 
     #[test]
     fn frames_without_counter() {
-        let mut p = SyncProducer::new(Duration::from_millis(10), None).unwrap();
+        let mut p = SyncProducer::new(Some(Duration::from_millis(10)), None).unwrap();
         assert_eq!(p.poll_timeout(), None);
         p.start(ms(100));
         assert!(frames(&mut p).is_empty());
@@ -341,7 +349,7 @@ mod tests {
 
     #[test]
     fn counter_wraps_at_the_overflow_value() {
-        let mut p = SyncProducer::new(Duration::from_millis(1), Some(3)).unwrap();
+        let mut p = SyncProducer::new(Some(Duration::from_millis(1)), Some(3)).unwrap();
         p.start(ms(0));
         let mut sent = Vec::new();
         for t in 1..=7 {
@@ -361,7 +369,8 @@ mod tests {
 
     #[test]
     fn counter_reaches_240() {
-        let mut p = SyncProducer::with_cob_id(0x081, Duration::from_millis(1), Some(240)).unwrap();
+        let mut p =
+            SyncProducer::with_cob_id(0x081, Some(Duration::from_millis(1)), Some(240)).unwrap();
         p.start(ms(0));
         let mut last = Vec::new();
         for t in 1..=241 {
@@ -378,20 +387,20 @@ mod tests {
     fn invalid_configuration_is_refused() {
         for v in [0u8, 1, 241, 255] {
             assert_eq!(
-                SyncProducer::new(Duration::from_millis(1), Some(v)).err(),
+                SyncProducer::new(Some(Duration::from_millis(1)), Some(v)).err(),
                 Some(SyncConfigError::CounterOverflow(v))
             );
         }
-        assert!(SyncProducer::new(Duration::from_millis(1), Some(2)).is_ok());
+        assert!(SyncProducer::new(Some(Duration::from_millis(1)), Some(2)).is_ok());
         assert_eq!(
-            SyncProducer::with_cob_id(0x800, Duration::from_millis(1), None).err(),
+            SyncProducer::with_cob_id(0x800, Some(Duration::from_millis(1)), None).err(),
             Some(SyncConfigError::CobId(0x800))
         );
     }
 
     #[test]
     fn big_time_jump_sends_one_frame() {
-        let mut p = SyncProducer::new(Duration::from_millis(1), Some(10)).unwrap();
+        let mut p = SyncProducer::new(Some(Duration::from_millis(1)), Some(10)).unwrap();
         p.start(ms(0));
         p.handle_timeout(ms(3_600_000));
         assert_eq!(frames(&mut p), [data(0x080, &[1])]);
@@ -404,21 +413,21 @@ mod tests {
 
     #[test]
     fn period_changes_and_zero_period() {
-        let mut p = SyncProducer::new(Duration::ZERO, None).unwrap();
-        p.set_period(ms(0), Duration::from_millis(20));
+        let mut p = SyncProducer::new(None, None).unwrap();
+        p.set_period(ms(0), Some(Duration::from_millis(20)));
         assert_eq!(p.poll_timeout(), None);
-        p.set_period(ms(0), Duration::ZERO);
+        p.set_period(ms(0), None);
         p.start(ms(0));
         assert!(p.is_running());
         assert_eq!(p.poll_timeout(), None);
-        p.set_period(ms(5), Duration::from_millis(20));
+        p.set_period(ms(5), Some(Duration::from_millis(20)));
         assert_eq!(p.poll_timeout(), Some(ms(25)));
-        p.set_period(ms(10), Duration::from_millis(50));
+        p.set_period(ms(10), Some(Duration::from_millis(50)));
         assert_eq!(p.poll_timeout(), Some(ms(60)));
-        p.set_period(ms(20), Duration::ZERO);
+        p.set_period(ms(20), None);
         assert_eq!(p.poll_timeout(), None);
         p.stop();
-        p.set_period(ms(30), Duration::from_millis(50));
+        p.set_period(ms(30), Some(Duration::from_millis(50)));
         assert_eq!(p.poll_timeout(), None);
     }
 

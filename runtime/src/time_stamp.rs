@@ -28,7 +28,7 @@
 //! assert_eq!(t.encode(), [0x95, 0x2C, 0xB3, 0x02, 0x3C, 0x3D]);
 //! assert_eq!(t.to_string(), "2026-12-02T12:34:56.789Z");
 //!
-//! let mut producer = TimeProducer::new(Duration::ZERO);
+//! let mut producer = TimeProducer::new(None);
 //! producer.send(t);
 //! let frame = producer.poll_transmit().unwrap();
 //! assert_eq!(frame.to_string(), "100#952CB3023C3D");

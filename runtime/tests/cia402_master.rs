@@ -9,7 +9,6 @@ use std::sync::{Arc, Mutex};
 use std::thread;
 use std::time::Duration;
 
-use eds2rust_runtime::Frame;
 use eds2rust_runtime::blocking::{self, Error, Master};
 use eds2rust_runtime::cia402::requirements::{Operation, Problem};
 use eds2rust_runtime::cia402::session::StatuswordPdo;
@@ -18,10 +17,12 @@ use eds2rust_runtime::cia402::{
 };
 use eds2rust_runtime::master;
 use eds2rust_runtime::od::{DataType, NodeId, ObjectInfo};
+use eds2rust_runtime::pdo::PdoCobId;
 use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::server::{SdoServer, ServerConfig};
 use eds2rust_runtime::transport::Clock;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
+use eds2rust_runtime::{CanId, Frame};
 
 #[path = "cia402_master/sim.rs"]
 mod sim;
@@ -63,7 +64,7 @@ impl Rig {
             };
             blocking::serve(&mut port, &device_clock, &mut node, &halt, None, |()| {}).unwrap();
         });
-        let core = master::Master::new(NodeId::new(1).unwrap(), Duration::ZERO);
+        let core = master::Master::new(NodeId::new(1).unwrap(), None);
         let mut master = Master::with_clock(bus.attach(), core, clock);
         master.start().unwrap();
         let monitor = bus.attach();
@@ -332,15 +333,15 @@ fn missing_objects_are_refused_before_any_frame() {
 #[test]
 fn statuswords_from_a_tpdo_without_polling() {
     let mut rig = Rig::new(DeviceConfig::default(), true);
-    let cob_id = 0x180 + u16::from(NODE);
+    let can_id = CanId::Standard(0x180 + u16::from(NODE));
     rig.master
         .core_mut()
         .pdo_rx
-        .watch(u32::from(cob_id), 2, None)
+        .watch(PdoCobId::new(can_id), 2, None)
         .unwrap();
     let config = fast_config()
         .with_poll_period(None)
-        .with_statusword_pdo(StatuswordPdo { cob_id, offset: 0 });
+        .with_statusword_pdo(StatuswordPdo { can_id, offset: 0 });
     let mut drive = rig.master.drive(node(), &FULL, config).unwrap();
     drive.enable().unwrap();
     drive.move_to(40, Move::default()).unwrap();
@@ -353,7 +354,7 @@ fn statuswords_from_a_tpdo_without_polling() {
         .filter(|f| f.cob_id() == Some(0x600 + u16::from(NODE)) && f.data()[0] == 0x40)
         .count();
     assert_eq!(uploads, 0);
-    assert!(seen.iter().any(|f| f.cob_id() == Some(cob_id)));
+    assert!(seen.iter().any(|f| f.id() == can_id));
 }
 
 #[test]

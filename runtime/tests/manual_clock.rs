@@ -45,7 +45,7 @@ fn rig() -> (Master<VirtualPort>, ManualClock, VirtualPort, VirtualBus) {
     let bus = VirtualBus::new();
     let peer = bus.attach();
     let time = ManualClock::new();
-    let mut core = master::Master::new(node(1), PERIOD);
+    let mut core = master::Master::new(node(1), Some(PERIOD));
     core.consumer
         .monitor(node(DEVICE), Duration::from_millis(100));
     let mut m = Master::with_clock(bus.attach(), core, time.clock());
@@ -153,7 +153,7 @@ fn the_heartbeat_keeps_its_period_during_a_slow_sdo_read() {
         answers: VecDeque::new(),
         sent: Vec::new(),
     };
-    let core = master::Master::new(node(1), PERIOD);
+    let core = master::Master::new(node(1), Some(PERIOD));
     let mut m = Master::with_clock(bus, core, time.clock());
     m.start().unwrap();
     assert_eq!(m.read::<DeviceType>(node(DEVICE)).unwrap(), 0x0002_0192);

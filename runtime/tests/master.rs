@@ -16,7 +16,7 @@ use eds2rust_runtime::lss::LssState;
 use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtSlave, NmtState};
 use eds2rust_runtime::od::{AccessRight, DataType, Entry, NodeId, PdoDirection, access};
-use eds2rust_runtime::pdo::{PdoConfig, PdoEvent};
+use eds2rust_runtime::pdo::{PdoCobId, PdoConfig, PdoEvent, TransmissionType};
 use eds2rust_runtime::sdo::client::Method;
 use eds2rust_runtime::sdo::server::{MemoryStore, ObjectStore, SdoServer, ServerConfig};
 use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};
@@ -188,7 +188,7 @@ impl Rig {
                     },
                 ),
                 nmt: NmtSlave::new(id),
-                heartbeat: HeartbeatProducer::new(id, Duration::from_millis(50)),
+                heartbeat: HeartbeatProducer::new(id, Some(Duration::from_millis(50))),
             };
             let clock = Clock::new();
             device.nmt.boot_complete();
@@ -197,7 +197,7 @@ impl Rig {
             blocking::serve(&mut port, &clock, &mut device, &halt, None, |()| {}).unwrap();
         }));
 
-        let mut core = master::Master::new(node(1), PERIOD);
+        let mut core = master::Master::new(node(1), Some(PERIOD));
         core.consumer
             .monitor(node(DEVICE), Duration::from_millis(200));
         let mut master = Master::new(master_port, core);
@@ -333,7 +333,11 @@ fn nmt_command_bytes_and_the_state_the_node_reports() {
 #[test]
 fn a_pdo_received_during_an_sdo_transfer_is_kept_and_queued() {
     let mut rig = Rig::new();
-    rig.master.core_mut().pdo_rx.watch(0x1A0, 2, None).unwrap();
+    rig.master
+        .core_mut()
+        .pdo_rx
+        .watch(PdoCobId(0x1A0), 2, None)
+        .unwrap();
     // Another node sends its TPDO1 (0x1A0) while the slow read runs; the
     // device answers the read only after that.
     let sender = rig.bus.attach();
@@ -353,7 +357,7 @@ fn a_pdo_received_during_an_sdo_transfer_is_kept_and_queued() {
     );
     pdo.join().unwrap();
     assert_eq!(
-        rig.master.core().pdo_rx.latest_data(0x1A0),
+        rig.master.core().pdo_rx.latest_data(CanId::Standard(0x1A0)),
         Some(&[0x11, 0x22][..])
     );
     // Queued events are offered first, even with a deadline already past;
@@ -363,7 +367,7 @@ fn a_pdo_received_during_an_sdo_transfer_is_kept_and_queued() {
         .master
         .run_until(StdInstant::now(), |e| match e {
             MasterEvent::Pdo(PdoEvent::Received {
-                cob_id: 0x1A0,
+                can_id: CanId::Standard(0x1A0),
                 data,
                 ..
             }) => ControlFlow::Break(*data),
@@ -407,7 +411,11 @@ fn queue_capacity_bounds_the_events_and_counts_the_dropped() {
     rig.master.drain_events().for_each(drop);
     rig.master.set_queue_capacity(2);
     let sender = rig.bus.attach();
-    rig.master.core_mut().pdo_rx.watch(0x1A0, 1, None).unwrap();
+    rig.master
+        .core_mut()
+        .pdo_rx
+        .watch(PdoCobId(0x1A0), 1, None)
+        .unwrap();
     for b in 1..=5 {
         sender.transmit(&frame(0x1A0, &[b]));
     }
@@ -417,7 +425,7 @@ fn queue_capacity_bounds_the_events_and_counts_the_dropped() {
     // The newest events stay; the three oldest were dropped and counted.
     let pdo = |b| {
         MasterEvent::Pdo(PdoEvent::Received {
-            cob_id: 0x1A0,
+            can_id: CanId::Standard(0x1A0),
             data: [b, 0, 0, 0, 0, 0, 0, 0],
             len: 1,
             at: Instant::ZERO,
@@ -427,9 +435,9 @@ fn queue_capacity_bounds_the_events_and_counts_the_dropped() {
         .into_iter()
         .map(|e| match e {
             MasterEvent::Pdo(PdoEvent::Received {
-                cob_id, data, len, ..
+                can_id, data, len, ..
             }) => MasterEvent::Pdo(PdoEvent::Received {
-                cob_id,
+                can_id,
                 data,
                 len,
                 at: Instant::ZERO,
@@ -468,9 +476,9 @@ fn configure_pdo_runs_the_steps_through_the_master() {
     let mut rig = Rig::new();
     // TPDO1 of the device: on 0x1A0, synchronous every SYNC, mapping
     // 0x2000:01 (32 bits).
-    let config = PdoConfig::new(PdoDirection::Tpdo, 1, 0x1A0, &[0x2000_0120])
+    let config = PdoConfig::new(PdoDirection::Tpdo, 1, PdoCobId(0x1A0), &[0x2000_0120])
         .unwrap()
-        .with_transmission_type(1);
+        .with_transmission_type(TransmissionType::from_raw(1));
     rig.master.configure_pdo(node(DEVICE), &config).unwrap();
     // A mapping index outside the TPDO range: refused before anything is sent.
     let mut bad = config;

@@ -2,7 +2,6 @@
 //! through each public way of naming an NMT target, and the master sends
 //! what it built. Node 0 on the wire comes only from `NmtTarget::All`.
 
-use core::time::Duration;
 
 use eds2rust_runtime::blocking::Master;
 use eds2rust_runtime::master;
@@ -14,7 +13,7 @@ use eds2rust_runtime::transport::virtual_bus::VirtualBus;
 fn only_nmt_target_all_sends_node_zero() {
     let bus = VirtualBus::new();
     let monitor = bus.attach();
-    let core = master::Master::new(NodeId::new(1).unwrap(), Duration::ZERO);
+    let core = master::Master::new(NodeId::new(1).unwrap(), None);
     let mut m = Master::new(bus.attach(), core);
     for id in 0..=u8::MAX {
         let valid = (1..=127).contains(&id);

@@ -10,10 +10,12 @@ use std::thread;
 use std::time::Duration;
 
 use eds2rust_runtime::blocking::{self, SdoClient};
+use eds2rust_runtime::od::standard::{EventTimer, InhibitTime};
 use eds2rust_runtime::od::{self, AccessRight, NodeId, PdoDirection, PdoLengthError};
 use eds2rust_runtime::pdo::blocking::{PdoConfigError, configure_pdo};
 use eds2rust_runtime::pdo::{
-    ConfigCheckError, PdoConfig, PdoEvent, PdoReceiver, PdoTransmitter, StepKind, TransmitterConfig,
+    ConfigCheckError, PdoCobId, PdoConfig, PdoEvent, PdoReceiver, PdoTransmitter, ReadBackMismatch,
+    StepKind, TransmissionType, TransmitterConfig,
 };
 use eds2rust_runtime::sdo::client::ClientConfig;
 use eds2rust_runtime::sdo::server::{MemoryStore, ObjectStore, SdoServer, ServerConfig};
@@ -21,7 +23,7 @@ use eds2rust_runtime::sdo::{AbortCode, Channel};
 use eds2rust_runtime::sync::SyncProducer;
 use eds2rust_runtime::transport::Clock;
 use eds2rust_runtime::transport::virtual_bus::VirtualBus;
-use eds2rust_runtime::{Frame, Instant, Service};
+use eds2rust_runtime::{CanId, Frame, Instant, Service};
 
 const NODE: u8 = 5;
 
@@ -189,11 +191,11 @@ fn configure(device: Device, config: &PdoConfig<'_>) -> (Result<(), PdoConfigErr
 /// The two-entry TPDO1: statusword then position, event-driven every
 /// 500 ms at most every 10 ms.
 fn tpdo1(entries: &[u32]) -> PdoConfig<'_> {
-    PdoConfig::new(PdoDirection::Tpdo, 1, 0x185, entries)
+    PdoConfig::new(PdoDirection::Tpdo, 1, PdoCobId(0x185), entries)
         .unwrap()
-        .with_transmission_type(254)
-        .with_inhibit_time(100)
-        .with_event_timer(500)
+        .with_transmission_type(TransmissionType::from_raw(254))
+        .with_inhibit_time(InhibitTime(100))
+        .with_event_timer(EventTimer(500))
 }
 
 #[test]
@@ -246,8 +248,8 @@ impl od::Pdo for Tpdo1 {
     const MAPPING_INDEX: u16 = 0x1A00;
     const LEN: usize = 6;
     const MAPPING: &'static [u32] = &[STATUSWORD, POSITION];
-    fn default_cob_id(node: NodeId) -> Option<u32> {
-        Some(0x4000_0180 + u32::from(node.get()))
+    fn default_cob_id(node: NodeId) -> Option<PdoCobId> {
+        Some(PdoCobId(0x4000_0180 + u32::from(node.get())))
     }
     fn decode(data: &[u8]) -> Result<Self, PdoLengthError> {
         match *data {
@@ -272,7 +274,7 @@ impl od::Pdo for Tpdo1 {
 fn configure_a_generated_pdo() {
     let config = PdoConfig::from_pdo::<Tpdo1>(node())
         .unwrap()
-        .with_transmission_type(1);
+        .with_transmission_type(TransmissionType::from_raw(1));
     let (result, device) = configure(Device::new(), &config);
     result.unwrap();
     assert_eq!(
@@ -317,7 +319,10 @@ fn a_value_the_device_does_not_keep_fails_the_read_back() {
     let entries = [STATUSWORD, POSITION];
     let (result, _) = configure(device, &tpdo1(&entries));
     let error = result.unwrap_err();
-    assert!(matches!(error, PdoConfigError::Mismatch { number: 12, .. }));
+    assert!(matches!(
+        error,
+        PdoConfigError::Mismatch(ReadBackMismatch { number: 12, .. })
+    ));
     assert_eq!(
         error.to_string(),
         "PDO configuration step 12 of 16 failed: read back mapping entry 2 of 0x1A00 (object \
@@ -439,11 +444,17 @@ impl Network {
 fn master_and_device_exchange_pdos_paced_by_sync() {
     let node = node();
     // RPDO1 of the device: synchronous cyclic, every 2nd SYNC.
-    let mut master_tx = PdoTransmitter::new(TransmitterConfig::new(0x205, 2)).unwrap();
+    let mut master_tx = PdoTransmitter::new(TransmitterConfig::new(
+        PdoCobId(0x205),
+        TransmissionType::from_raw(2),
+    ))
+    .unwrap();
     // TPDO1 of the device: event-driven, inhibit 5 ms, event timer 40 ms.
-    let mut device_config = TransmitterConfig::from_pdo::<Tpdo1>(node, 254).unwrap();
-    device_config.inhibit_time = 50;
-    device_config.event_timer = 40;
+    let mut device_config =
+        TransmitterConfig::from_pdo::<Tpdo1>(node, TransmissionType::EventDrivenManufacturer)
+            .unwrap();
+    device_config.inhibit_time = InhibitTime(50);
+    device_config.event_timer = EventTimer(40);
     let device_tx = PdoTransmitter::new(device_config).unwrap();
     let mut master_rx = PdoReceiver::new();
     let tpdo = master_rx.watch_pdo::<Tpdo1>(node).unwrap();
@@ -451,8 +462,8 @@ fn master_and_device_exchange_pdos_paced_by_sync() {
         .set_timeout(tpdo, Some(Duration::from_millis(100)))
         .unwrap();
     let mut device_rx = PdoReceiver::new();
-    device_rx.watch(0x205, 2, None).unwrap();
-    let mut sync = SyncProducer::new(Duration::from_millis(10), None).unwrap();
+    device_rx.watch(PdoCobId(0x205), 2, None).unwrap();
+    let mut sync = SyncProducer::new(Some(Duration::from_millis(10)), None).unwrap();
     sync.start(Instant::ZERO);
     master_tx.set_data(Instant::ZERO, &[0x0F, 0x00]).unwrap();
     let mut net = Network {
@@ -473,7 +484,10 @@ fn master_and_device_exchange_pdos_paced_by_sync() {
         [(20, vec![0x0F, 0x00]), (40, vec![0x0F, 0x00])]
     );
     assert_eq!(net.device_events.len(), 2);
-    assert_eq!(net.device_rx.latest_data(0x205), Some(&[0x0F, 0x00][..]));
+    assert_eq!(
+        net.device_rx.latest_data(CanId::Standard(0x205)),
+        Some(&[0x0F, 0x00][..])
+    );
 
     // The device reports three changes within 1 ms: one frame now, one
     // with the latest value when the 5 ms inhibit time ends.
@@ -508,7 +522,7 @@ fn master_and_device_exchange_pdos_paced_by_sync() {
     // The device goes silent (PDO disabled): the master reports the
     // timeout once, 100 ms after the last TPDO.
     net.device_tx
-        .set_cob_id(Instant::from_millis(121), 0xC000_0185)
+        .set_cob_id(Instant::from_millis(121), PdoCobId(0xC000_0185))
         .unwrap();
     let last = net.sent_on(0x185).last().unwrap().0;
     net.run_until(121, 400);
@@ -517,7 +531,12 @@ fn master_and_device_exchange_pdos_paced_by_sync() {
         .iter()
         .filter(|e| matches!(e, PdoEvent::Timeout { .. }))
         .collect();
-    assert_eq!(timeouts, [&PdoEvent::Timeout { cob_id: 0x185 }]);
+    assert_eq!(
+        timeouts,
+        [&PdoEvent::Timeout {
+            can_id: CanId::Standard(0x185)
+        }]
+    );
     assert!(net.master_rx.is_timed_out(tpdo));
     assert_eq!(last, 91);
     let received_at: Vec<u64> = net

@@ -113,7 +113,7 @@ proptest! {
             0..32)
     ) {
         let mut consumer = TimeConsumer::new();
-        let mut master = Master::new(NodeId::new(1).unwrap(), Duration::ZERO);
+        let mut master = Master::new(NodeId::new(1).unwrap(), None);
         master.start(Instant::ZERO);
         while master.poll_transmit().is_some() {}
         for (i, (id, extended, remote, data)) in frames.iter().enumerate() {
@@ -146,7 +146,7 @@ proptest! {
         t in time(),
         steps in proptest::collection::vec(0u64..5_000_000, 1..16)
     ) {
-        let mut producer = TimeProducer::new(Duration::from_millis(100));
+        let mut producer = TimeProducer::new(Some(Duration::from_millis(100)));
         producer.set_time(Instant::ZERO, t);
         producer.start(Instant::ZERO);
         let mut consumer = TimeConsumer::new();

@@ -69,7 +69,7 @@ impl Rig {
             )
             .await;
         });
-        let core = master::Master::new(NodeId::new(1).unwrap(), Duration::ZERO);
+        let core = master::Master::new(NodeId::new(1).unwrap(), None);
         let (master, run) = Master::new(bus.attach(), core);
         let driver = tokio::spawn(run.run());
         Rig {

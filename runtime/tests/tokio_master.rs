@@ -13,8 +13,9 @@ use eds2rust_runtime::Frame;
 use eds2rust_runtime::blocking::Error;
 use eds2rust_runtime::master;
 use eds2rust_runtime::nmt::{NmtCommand, NmtTarget};
+use eds2rust_runtime::od::standard::EventTimer;
 use eds2rust_runtime::od::{self, PdoDirection};
-use eds2rust_runtime::pdo::{PdoConfig, StepAction};
+use eds2rust_runtime::pdo::{PdoCobId, PdoConfig, StepAction, TransmissionType};
 use eds2rust_runtime::sdo::client::Method;
 use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};
 use eds2rust_runtime::tokio::{Driver, Master};
@@ -183,10 +184,15 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
 #[tokio::test(start_paused = true)]
 async fn configure_pdo_writes_in_the_cia_301_order_and_reads_back() {
     let rig = Rig::new(|_| {}).await;
-    let config = PdoConfig::new(PdoDirection::Tpdo, 1, 0x1A0, <Counter as od::Pdo>::MAPPING)
-        .unwrap()
-        .with_transmission_type(1)
-        .with_event_timer(100);
+    let config = PdoConfig::new(
+        PdoDirection::Tpdo,
+        1,
+        PdoCobId(0x1A0),
+        <Counter as od::Pdo>::MAPPING,
+    )
+    .unwrap()
+    .with_transmission_type(TransmissionType::from_raw(1))
+    .with_event_timer(EventTimer(100));
     rig.seen();
     rig.master
         .configure_pdo(node(DEVICE), &config)
@@ -280,7 +286,7 @@ async fn the_driver_ends_with_the_last_handle_and_calls_fail_after_it_stopped() 
 
     // A driver dropped without running: calls fail at once.
     let bus = VirtualBus::new();
-    let core = master::Master::new(node(1), Duration::ZERO);
+    let core = master::Master::new(node(1), None);
     let (master, driver): (Master, Driver<VirtualPort>) = Master::new(bus.attach(), core);
     drop(driver);
     assert!(!master.is_running());
@@ -303,14 +309,19 @@ fn futures_are_send() {
         .unwrap();
     let _guard = rt.enter();
     let bus = VirtualBus::new();
-    let core = master::Master::new(node(1), Duration::ZERO);
+    let core = master::Master::new(node(1), None);
     let (m, driver) = Master::new(bus.attach(), core);
     assert_send(&m.read::<ProducerHeartbeatTime>(node(DEVICE)));
     assert_send(&m.upload(node(DEVICE), 0x1000, 0));
     assert_send(&m.lss_inquire_node_id());
     assert_send(&m.nmt(NmtCommand::Start, NmtTarget::All));
-    let config =
-        PdoConfig::new(PdoDirection::Tpdo, 1, 0x1A0, <Counter as od::Pdo>::MAPPING).unwrap();
+    let config = PdoConfig::new(
+        PdoDirection::Tpdo,
+        1,
+        PdoCobId(0x1A0),
+        <Counter as od::Pdo>::MAPPING,
+    )
+    .unwrap();
     assert_send(&m.configure_pdo(node(DEVICE), &config));
     assert_send(&driver.run());
 }

@@ -9,14 +9,15 @@ use rig::*;
 
 use std::time::Duration;
 
-use eds2rust_runtime::Frame;
 use eds2rust_runtime::emcy::EmcyEvent;
 use eds2rust_runtime::heartbeat::HeartbeatEvent;
 use eds2rust_runtime::lss::{IdentityField, LssState};
 use eds2rust_runtime::master::MasterEvent;
 use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState, NmtTarget};
 use eds2rust_runtime::od::PdoLengthError;
+use eds2rust_runtime::pdo::PdoCobId;
 use eds2rust_runtime::sync::SyncProducer;
+use eds2rust_runtime::{CanId, Frame};
 use tokio::time::Instant as TokioInstant;
 
 #[tokio::test(start_paused = true)]
@@ -96,11 +97,11 @@ async fn emcy_and_nmt_events_and_command_frames() {
 #[tokio::test(start_paused = true)]
 async fn pdo_stream_yields_decoded_values() {
     let rig = Rig::new(|core| {
-        core.sync = Some(SyncProducer::new(Duration::from_millis(10), None).unwrap());
+        core.sync = Some(SyncProducer::new(Some(Duration::from_millis(10)), None).unwrap());
     })
     .await;
     let mut pdos = rig.master.pdos::<Counter>(node(DEVICE)).unwrap();
-    assert_eq!(pdos.cob_id(), 0x1A0);
+    assert_eq!(pdos.can_id(), CanId::Standard(0x1A0));
     let first = pdos.next().await.unwrap().unwrap();
     let second = pdos.next().await.unwrap().unwrap();
     let third = pdos.next().await.unwrap().unwrap();
@@ -132,7 +133,7 @@ async fn pdo_stream_yields_decoded_values() {
 #[tokio::test(start_paused = true)]
 async fn a_full_event_stream_drops_the_oldest_and_counts_them() {
     let rig = Rig::new(|core| {
-        core.pdo_rx.watch(0x1A5, 1, None).unwrap();
+        core.pdo_rx.watch(PdoCobId(0x1A5), 1, None).unwrap();
     })
     .await;
     // After the device's boot-up, before its first heartbeat.

@@ -16,7 +16,7 @@ use eds2rust_runtime::nmt::NmtSlave;
 use eds2rust_runtime::od::{
     self, AccessRight, DataType, Entry, NodeId, PdoDirection, PdoLengthError, access,
 };
-use eds2rust_runtime::pdo::{PdoTransmitter, TransmitterConfig};
+use eds2rust_runtime::pdo::{PdoCobId, PdoTransmitter, TransmissionType, TransmitterConfig};
 use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
 use eds2rust_runtime::tokio::{self as driver, Deadline, Events, Master};
@@ -73,8 +73,8 @@ impl od::Pdo for Counter {
     const MAPPING_INDEX: u16 = 0x1A00;
     const LEN: usize = 2;
     const MAPPING: &'static [u32] = &[0x2001_0010];
-    fn default_cob_id(node_id: NodeId) -> Option<u32> {
-        Some(0x180 + u32::from(node_id.get()))
+    fn default_cob_id(node_id: NodeId) -> Option<PdoCobId> {
+        Some(PdoCobId(0x180 + u32::from(node_id.get())))
     }
     fn decode(data: &[u8]) -> Result<Self, PdoLengthError> {
         let bytes = eds2rust_runtime::pdo::layout::load::<2>(data)?;
@@ -109,12 +109,16 @@ impl Device {
         store.insert_fixed(0x1800, 5, AccessRight::Rw, &[0; 2]);
         store.insert_fixed(0x1A00, 0, AccessRight::Rw, &[0]);
         store.insert_fixed(0x1A00, 1, AccessRight::Rw, &[0; 4]);
-        let mut tpdo = PdoTransmitter::new(TransmitterConfig::new(0x1A0, 1)).unwrap();
+        let mut tpdo = PdoTransmitter::new(TransmitterConfig::new(
+            PdoCobId(0x1A0),
+            TransmissionType::from_raw(1),
+        ))
+        .unwrap();
         tpdo.set_data(Instant::ZERO, &0u16.to_le_bytes()).unwrap();
         Device {
             sdo: SdoServer::new(ServerConfig::new(Channel::default_for(id)), store),
             nmt: NmtSlave::new(id),
-            heartbeat: HeartbeatProducer::new(id, Duration::from_millis(50)),
+            heartbeat: HeartbeatProducer::new(id, Some(Duration::from_millis(50))),
             lss: LssSlave::new(IDENTITY, Some(id), BitTiming::standard(BitRate::Kbit500)),
             tpdo,
             counter: 0,
@@ -198,7 +202,7 @@ impl Rig {
         let bus = VirtualBus::new();
         let monitor = bus.attach();
         let device = spawn_device(bus.attach());
-        let mut core = master::Master::new(node(1), Duration::from_millis(100));
+        let mut core = master::Master::new(node(1), Some(Duration::from_millis(100)));
         configure(&mut core);
         let (master, driver) = Master::new(bus.attach(), core);
         let events = master.events();

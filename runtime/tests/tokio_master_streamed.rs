@@ -206,7 +206,7 @@ fn streamed_futures_are_send() {
         .build()
         .unwrap();
     let _entered = runtime.enter();
-    let core = eds2rust_runtime::master::Master::new(node(1), Duration::ZERO);
+    let core = eds2rust_runtime::master::Master::new(node(1), None);
     let (m, _driver) = eds2rust_runtime::tokio::Master::new(bus.attach(), core);
     let mut reader: &[u8] = &[1, 2, 3];
     let download = m.download_from(node(2), 0x2100, 0, &mut reader, None, Method::Auto, |_| {});

@@ -236,7 +236,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Res<Summary> {
         let model = Ec5000Bi::new().with_time_scale(scale);
         simulator_with(model, default_config(DEFAULT_SERIAL), now)
     })?;
-    let core = master::Master::new(node(1)?, Duration::ZERO);
+    let core = master::Master::new(node(1)?, None);
     let mut m = blocking::Master::with_clock(harness.take_port()?, core, harness.clock());
     m.start()?;
     let result = scenario(&mut m, args, out);

@@ -34,7 +34,6 @@ use eds2rust_runtime::emcy::EmcyEvent;
 use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState};
 use eds2rust_runtime::od::NodeId;
-use eds2rust_runtime::pdo::{PdoEvent, TransmitterConfig};
 use eds2rust_sim::harness::{Args, Harness, MasterPort};
 use eds2rust_sim::models::linak_techline::{LinakTechline, NODE, default_config, simulator_with};
 
@@ -106,14 +105,8 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<Summary> {
         )
     })?;
     let me = NodeId::new(MASTER_NODE).ok_or_else(|| ScenarioError("master node id".into()))?;
-    let mut core = master::Master::new(me, MASTER_HEARTBEAT);
+    let mut core = master::Master::new(me, Some(MASTER_HEARTBEAT));
     core.heartbeat.set_state(NmtState::Operational);
-    core.pdo_rx
-        .watch_pdo::<Tpdo1Feedback>(NODE)
-        .map_err(|e| ScenarioError(format!("watch TPDO1: {e:?}")))?;
-    let rpdo = core
-        .add_pdo_tx(TransmitterConfig::new(Rpdo1Command::cob_id(NODE), 254))
-        .map_err(|e| ScenarioError(format!("RPDO1 of node {NODE}: {e:?}")))?;
     let mut m = Master::with_clock(harness.take_port()?, core, harness.clock());
     // A stroke takes about 10 s at 5 mm/s; a real actuator may be longer
     // and slower, and does not follow the time scale.
@@ -151,7 +144,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<Summary> {
     let first = next_feedback(&mut m, ANSWER_TIMEOUT, "after NMT start")?;
     report(out, "operational", &first)?;
 
-    send(&mut m, rpdo, command::PositionValue::STOP)?;
+    send(&mut m, command::PositionValue::STOP)?;
     let ready = wait_feedback(
         &mut m,
         out,
@@ -161,14 +154,14 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<Summary> {
     )?;
     report(out, "stop", &ready)?;
 
-    send(&mut m, rpdo, command::PositionValue::RUN_OUT)?;
+    send(&mut m, command::PositionValue::RUN_OUT)?;
     writeln!(out, "run out")?;
     let outside = wait_feedback(&mut m, out, stroke_time, "end stop out", |f| {
         f.status_flags.end_stop_out()
     })?;
     report(out, "end stop out", &outside)?;
 
-    send(&mut m, rpdo, command::PositionValue::RUN_IN)?;
+    send(&mut m, command::PositionValue::RUN_IN)?;
     writeln!(out, "run in")?;
     let inside = wait_feedback(&mut m, out, stroke_time, "end stop in", |f| {
         f.status_flags.end_stop_in() && !f.status_flags.running_in()
@@ -204,8 +197,8 @@ fn wait_boot_up(m: &mut Master) -> Result<()> {
 
 /// Sends RPDO1 with `position` and every other field at its default
 /// (0xFB), as the manual's trace does.
-fn send(m: &mut Master, rpdo: usize, position: command::PositionValue) -> Result<()> {
-    let frame = Rpdo1Command {
+fn send(m: &mut Master, position: command::PositionValue) -> Result<()> {
+    let command = Rpdo1Command {
         position,
         current_limit: command::CurrentLimitValue::DEFAULT,
         speed: command::SpeedValue::DEFAULT,
@@ -214,50 +207,29 @@ fn send(m: &mut Master, rpdo: usize, position: command::PositionValue) -> Result
         reserved_6: 0,
         reserved_7: 0,
     };
-    let now = m.now();
-    let tx = m
-        .core_mut()
-        .pdo_tx
-        .get_mut(rpdo)
-        .ok_or_else(|| ScenarioError(format!("node {NODE}: RPDO1 transmitter missing")))?;
-    tx.set(now, &frame)
-        .map_err(|e| ScenarioError(format!("node {NODE}: RPDO1 {frame:?}: {e:?}")))?;
-    m.flush()?;
+    m.send_pdo(NODE, &command)
+        .map_err(|e| ScenarioError(format!("node {NODE}: RPDO1 {command:?}: {e}")))?;
     Ok(())
 }
 
-/// The next TPDO1 of the actuator; an EMCY from it is an error.
+/// The next TPDO1 of the actuator; an EMCY from it meanwhile is an error.
 fn next_feedback(m: &mut Master, timeout: Duration, what: &str) -> Result<Tpdo1Feedback> {
-    let cob = Tpdo1Feedback::can_id(NODE) as u16;
-    let deadline = std::time::Instant::now() + timeout;
-    let got = m
-        .run_until(deadline, |e| match e {
-            MasterEvent::Pdo(PdoEvent::Received {
-                cob_id, data, len, ..
-            }) if *cob_id == cob => {
-                ControlFlow::Break(Ok(data.get(..*len).unwrap_or(&[]).to_vec()))
-            }
-            MasterEvent::Emcy(EmcyEvent::Emergency { node, emcy })
-                if *node == NODE && emcy.code != 0 =>
-            {
-                ControlFlow::Break(Err(emcy.code))
-            }
-            _ => ControlFlow::Continue(()),
-        })
-        .map_err(|e| {
-            wait_error(
-                e,
-                &format!("node {NODE}: no TPDO1 (0x{cob:03X}) {what} within {timeout:?}"),
-            )
-        })?;
-    match got {
-        Ok(data) => Tpdo1Feedback::decode(&data)
-            .map_err(|e| ScenarioError(format!("node {NODE}: TPDO1 {what}: {e:?}")).into()),
-        Err(code) => Err(ScenarioError(format!(
-            "node {NODE}: EMCY 0x{code:04X} while waiting for {what}"
-        ))
-        .into()),
+    let feedback = m
+        .next_pdo::<Tpdo1Feedback>(NODE, timeout)
+        .map_err(|e| ScenarioError(format!("node {NODE}: TPDO1 {what}: {e}")))?;
+    for event in m.drain_events() {
+        if let MasterEvent::Emcy(EmcyEvent::Emergency { node, emcy }) = event
+            && node == NODE
+            && emcy.code != 0
+        {
+            return Err(ScenarioError(format!(
+                "node {NODE}: EMCY 0x{:04X} while waiting for {what}",
+                emcy.code
+            ))
+            .into());
+        }
     }
+    Ok(feedback)
 }
 
 /// TPDO1s until `done` holds, printing those on the way.

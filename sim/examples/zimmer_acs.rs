@@ -22,6 +22,7 @@ use std::time::{Duration, Instant as WallClock};
 
 use eds2rust_drivers::zimmer_acs::od;
 use eds2rust_drivers::zimmer_acs::pdo::Tpdo1StatusAndPosition;
+use eds2rust_runtime::CanId;
 use eds2rust_runtime::blocking;
 use eds2rust_runtime::cia402::{
     Drive, DriveConfig, Event, ModeOfOperation, Move, State, Statusword,
@@ -100,11 +101,11 @@ pub fn run(args: &Args, out: &mut dyn std::io::Write) -> Result<Summary, Box<dyn
         zimmer_acs::simulator_with(model, zimmer_acs::default_config(), now)
     })?;
     let me = NodeId::new(MASTER_NODE).ok_or_else(|| fail("bad master node id".into()))?;
-    let core = master::Master::new(me, Duration::ZERO);
+    let core = master::Master::new(me, None);
     let mut session = Session {
         master: blocking::Master::with_clock(harness.take_port()?, core, harness.clock()),
         drive: Drive::new(DriveConfig::default()),
-        tpdo1: 0,
+        tpdo1: Tpdo1StatusAndPosition::can_id(NODE),
         last_statusword: WallClock::now(),
         last_print: None,
         position_um: None,
@@ -126,7 +127,7 @@ pub fn run(args: &Args, out: &mut dyn std::io::Write) -> Result<Summary, Box<dyn
 struct Session<'a> {
     master: blocking::Master<MasterPort>,
     drive: Drive,
-    tpdo1: u16,
+    tpdo1: CanId,
     last_statusword: WallClock,
     last_print: Option<WallClock>,
     position_um: Option<i32>,
@@ -310,12 +311,12 @@ impl Session<'_> {
                 .wait_event(self.master.now() + Duration::from_millis(10))?
             {
                 Some(MasterEvent::Pdo(PdoEvent::Received {
-                    cob_id, data, len, ..
-                })) if cob_id == self.tpdo1 => {
+                    can_id, data, len, ..
+                })) if can_id == self.tpdo1 => {
                     let tpdo = Tpdo1StatusAndPosition::decode(data.get(..len).unwrap_or(&[]))
                         .map_err(|e| {
                             fail(format!(
-                                "node {NODE}: TPDO1 {cob_id:#05X} has {} bytes, not {}",
+                                "node {NODE}: TPDO1 {can_id} has {} bytes, not {}",
                                 e.actual, e.expected
                             ))
                         })?;

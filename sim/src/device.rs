@@ -218,8 +218,8 @@ impl<B: Behaviour> Device<B> {
             self.server.set_extra_channels(Vec::new());
             return;
         };
-        let period = d.table.get_uint(0x1017, 0).unwrap_or(0);
-        let mut producer = HeartbeatProducer::new(node, Duration::from_millis(period));
+        let ms = d.table.get_uint(0x1017, 0).unwrap_or(0);
+        let mut producer = HeartbeatProducer::new(node, producer_time(ms));
         producer.start(now);
         self.heartbeat = Some(producer);
         self.configure_consumer();
@@ -364,7 +364,7 @@ impl<B: Behaviour> Device<B> {
                 0x1017 => {
                     let ms = self.table().get_uint(0x1017, 0).unwrap_or(0);
                     if let Some(hb) = self.heartbeat.as_mut() {
-                        hb.set_period(now, Duration::from_millis(ms));
+                        hb.set_period(now, producer_time(ms));
                     }
                 }
                 0x1016 => self.configure_consumer(),
@@ -410,8 +410,8 @@ impl<B: Behaviour> Device<B> {
                 let _ = tpdo.tx.set_data(now, &data);
             }
             if requests.contains(&tpdo.number)
-                && tpdo.tx.cob_id().valid
-                && let Ok(frame) = Frame::new(CanId::Standard(tpdo.tx.cob_id().id), &data)
+                && tpdo.tx.is_enabled()
+                && let Ok(frame) = Frame::new(tpdo.tx.can_id(), &data)
             {
                 self.outbox.push_back(frame);
             }
@@ -419,10 +419,8 @@ impl<B: Behaviour> Device<B> {
     }
 
     fn receive_pdo(&mut self, now: Instant, frame: &Frame) -> bool {
-        let Some(id) = frame.cob_id() else {
-            return false;
-        };
-        let Some(i) = self.rpdos.iter().position(|r| r.cob_id == id) else {
+        let id = frame.id();
+        let Some(i) = self.rpdos.iter().position(|r| r.can_id == id) else {
             return false;
         };
         if frame.is_remote() {
@@ -521,4 +519,9 @@ fn server_config(node: Option<NodeId>) -> ServerConfig {
         None => Channel::standard(0x600, 0x580),
     };
     ServerConfig::new(channel)
+}
+
+/// The heartbeat period of object 0x1017's value in ms (0: none).
+fn producer_time(ms: u64) -> Option<Duration> {
+    (ms != 0).then(|| Duration::from_millis(ms))
 }

@@ -96,7 +96,7 @@ impl Rig {
             Cia402::new(),
             Instant::ZERO,
         );
-        let master = Master::new(NodeId::new(1).expect("master"), Duration::ZERO);
+        let master = Master::new(NodeId::new(1).expect("master"), None);
         let mut rig = Rig {
             bench: Bench::new(master, device, Instant::ZERO),
             drive: Drive::new(DriveConfig::default()),

@@ -6,7 +6,6 @@
 //! the IR.
 
 use std::path::{Path, PathBuf};
-use std::time::Duration;
 
 use eds2rust::input::{Options, read_device};
 use eds2rust::ir::Value;
@@ -62,7 +61,7 @@ fn every_corpus_file_boots_and_answers_its_identity() {
         };
         let node = table.node.or(NodeId::new(5)).expect("node id");
         let device = Device::new(table.objects, DeviceConfig::node(node), (), Instant::ZERO);
-        let master = Master::new(NodeId::new(1).expect("master"), Duration::ZERO);
+        let master = Master::new(NodeId::new(1).expect("master"), None);
         let mut bench = Bench::new(master, device, Instant::ZERO);
         let boot = format!("{:03X}#00", 0x700 + u16::from(node.get()));
         assert!(

@@ -33,7 +33,7 @@ fn example_bench() -> Bench<()> {
         Instant::ZERO,
     );
     // The master's heartbeat is off, to keep the traces short.
-    Bench::new(Master::new(node(1), Duration::ZERO), device, Instant::ZERO)
+    Bench::new(Master::new(node(1), None), device, Instant::ZERO)
 }
 
 fn abort(code: AbortCode) -> Result<(), SdoError> {
@@ -239,7 +239,7 @@ fn store_and_restore_signatures_survive_a_power_cycle() {
         (),
         Instant::ZERO,
     );
-    let mut b = Bench::new(Master::new(node(1), Duration::ZERO), device, Instant::ZERO);
+    let mut b = Bench::new(Master::new(node(1), None), device, Instant::ZERO);
     let n = node(40);
     // Producer heartbeat time, a plain rw entry.
     b.download(n, 0x1017, 0, &[0x2C, 0x01])
@@ -279,7 +279,7 @@ fn an_unconfigured_lss_slave_gets_its_node_id_and_moves_its_sdo_server() {
         bit_rate: BitRate::Kbit250,
     };
     let device = Device::new(example::od::OBJECTS, config, (), Instant::ZERO);
-    let mut b = Bench::new(Master::new(node(1), Duration::ZERO), device, Instant::ZERO);
+    let mut b = Bench::new(Master::new(node(1), None), device, Instant::ZERO);
     b.run_for(Duration::from_millis(100));
     // Unconfigured: no boot-up, no heartbeat (701#00 is the master's).
     assert_eq!(b.trace_lines(), ["701#00"]);
@@ -348,7 +348,7 @@ fn an_additional_sdo_channel_with_29_bit_ids_is_served() {
     table.sort_by_key(|o| (o.index, o.subindex));
     let table: &'static [ObjectInfo] = Box::leak(table.into_boxed_slice());
     let device = Device::new(table, DeviceConfig::node(node(5)), (), Instant::ZERO);
-    let mut b = Bench::new(Master::new(node(1), Duration::ZERO), device, Instant::ZERO);
+    let mut b = Bench::new(Master::new(node(1), None), device, Instant::ZERO);
     b.run_for(Duration::from_millis(10));
 
     // The master reaches the second channel through a client of its own,

@@ -27,7 +27,7 @@ fn bench(scale: f64) -> Bench<Ec5000Bi> {
     let model = Ec5000Bi::new().with_time_scale(scale);
     let device = simulator_with(model, default_config(DEFAULT_SERIAL), Instant::ZERO);
     // Master heartbeat 0: only its boot-up message.
-    let master = Master::new(node(1), Duration::ZERO);
+    let master = Master::new(node(1), None);
     let mut b = Bench::new(master, device, Instant::ZERO);
     b.run_for(Duration::from_millis(1));
     b

@@ -34,7 +34,7 @@ fn frame(id: u16, data: &[u8]) -> Frame {
 /// Master node 1 with the manual's heartbeat (0x701, every 100 ms, state
 /// Operational = 0x05) and the actuator at power-on.
 fn bench_with(model: LinakTechline) -> B {
-    let mut master = Master::new(NodeId::new(1).expect("node 1"), ms(100));
+    let mut master = Master::new(NodeId::new(1).expect("node 1"), Some(ms(100)));
     master.heartbeat.set_state(NmtState::Operational);
     let device = simulator_with(model, default_config(), Instant::ZERO);
     Bench::new(master, device, Instant::ZERO)
@@ -286,7 +286,7 @@ fn heartbeat_loss_stops_sets_error_5_and_sends_emcy_0x8130() {
     b.run_for(ms(500));
     assert_eq!(b.device.behaviour().running(), Some(Direction::Out));
     let now = b.now();
-    b.master.heartbeat.set_period(now, Duration::ZERO);
+    b.master.heartbeat.set_period(now, None);
     let mark = b.trace.len();
     b.run_for(ms(400));
     let lines = lines_since(&b, mark);
@@ -307,7 +307,7 @@ fn heartbeat_loss_stops_sets_error_5_and_sends_emcy_0x8130() {
     );
     // Heartbeat back: bit 5 clears, error 5 stays until Clear error.
     let now = b.now();
-    b.master.heartbeat.set_period(now, ms(100));
+    b.master.heartbeat.set_period(now, Some(ms(100)));
     b.run_for(ms(150));
     assert_eq!(read(&mut b, 0x2001, 3), [0x80]);
     assert_eq!(read(&mut b, 0x2001, 4), [0x05]);

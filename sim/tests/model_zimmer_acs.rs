@@ -27,7 +27,7 @@ fn ms(n: u64) -> Duration {
 
 fn bench_with(model: ZimmerAcs) -> Bench<ZimmerAcs> {
     let device = simulator_with(model, default_config(), Instant::ZERO);
-    let master = Master::new(NodeId::new(1).expect("node 1"), Duration::ZERO);
+    let master = Master::new(NodeId::new(1).expect("node 1"), None);
     let mut b = Bench::new(master, device, Instant::ZERO);
     b.run_for(ms(1));
     b

@@ -408,7 +408,7 @@ fn our_heartbeat_reaches_python() {
     // python's RemoteNode exists before our node boots.
     assert_eq!(remote(py)["heard"], json!([]));
 
-    let mut producer = HeartbeatProducer::new(n, Duration::from_millis(20));
+    let mut producer = HeartbeatProducer::new(n, Some(Duration::from_millis(20)));
     producer.start(clock.now());
     producer.set_state(NmtState::PreOperational);
     // Runs the producer until it sent `count` more frames.

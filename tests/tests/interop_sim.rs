@@ -16,7 +16,9 @@ use std::time::{Duration, Instant as StdInstant};
 use eds2rust::eds::Options;
 use eds2rust::r#gen::eds::to_eds;
 use eds2rust_drivers::{interroll_ec5000bi, linak_techline, zimmer_acs};
+use eds2rust_runtime::od::standard::EventTimer;
 use eds2rust_runtime::od::{NodeId, Pdo};
+use eds2rust_runtime::pdo::TransmissionType;
 use eds2rust_runtime::transport::Clock;
 use eds2rust_runtime::{Instant, blocking};
 use eds2rust_sim::models;
@@ -129,7 +131,7 @@ fn check_map<P: Pdo>(maps: &BTreeMap<u64, PyMap>, number: u64, node: NodeId) {
     assert!(map.enabled, "TPDO {number} disabled: {map:?}");
     assert_eq!(
         Some(map.cob_id),
-        P::default_cob_id(node),
+        P::default_cob_id(node).map(|cob| cob.to_raw()),
         "TPDO {number} COB-ID"
     );
     let mapped: Vec<u32> = P::MAPPING.to_vec();
@@ -370,12 +372,12 @@ fn derived_pdos_are_configured_and_read_back_by_python() {
     let mut watch = bus.attach();
     let tpdo = PdoConfig::from_pdo::<StatusVelocity>(drive)
         .expect("TPDO4 has a predefined COB-ID")
-        .with_transmission_type(255)
-        .with_event_timer(20);
+        .with_transmission_type(TransmissionType::EventDrivenProfile)
+        .with_event_timer(EventTimer(20));
     eds2rust_runtime::pdo::blocking::configure_pdo(&mut sdo, &tpdo).expect("TPDO4 configured");
     let rpdo = PdoConfig::from_pdo::<ControlVelocity>(drive)
         .expect("RPDO4 has a predefined COB-ID")
-        .with_transmission_type(255);
+        .with_transmission_type(TransmissionType::EventDrivenProfile);
     eds2rust_runtime::pdo::blocking::configure_pdo(&mut sdo, &rpdo).expect("RPDO4 configured");
     assert_eq!(sdo.upload(0x1A03, 0).expect("0x1A03 sub 0"), [3]);
     assert_eq!(
@@ -390,8 +392,7 @@ fn derived_pdos_are_configured_and_read_back_by_python() {
         control: <od::Controlword as Entry>::Value::from_raw(0x0006),
         velocity: od::TargetVelocityValue::from_raw(1200),
     };
-    let cob = ControlVelocity::can_id(drive) as u16;
-    let frame = Frame::new(CanId::Standard(cob), &command.encode()).expect("RPDO4 frame");
+    let frame = Frame::new(ControlVelocity::can_id(drive), &command.encode()).expect("RPDO4 frame");
     // The device takes its frames in send order on its one port: it is
     // operational before the RPDO, and has written the RPDO before it
     // answers the SDO reads below.
@@ -411,7 +412,7 @@ fn derived_pdos_are_configured_and_read_back_by_python() {
     // still say so).
     let status = sdo.read::<od::Statusword>().expect("0x6041");
     let mode = sdo.read::<od::ModesOfOperationDisplay>().expect("0x6061");
-    let cob = StatusVelocity::can_id(drive) as u16;
+    let tpdo4 = StatusVelocity::can_id(drive);
     let deadline = StdInstant::now() + Duration::from_secs(3);
     let mut last = None;
     loop {
@@ -420,7 +421,7 @@ fn derived_pdos_are_configured_and_read_back_by_python() {
             "no TPDO4 with statusword {status:?} on the in-process bus; last {last:?}"
         );
         if let Some(f) = watch.recv(Duration::from_millis(100)).expect("receive")
-            && f.id() == CanId::Standard(cob)
+            && f.id() == tpdo4
         {
             let p = StatusVelocity::decode(f.data()).expect("TPDO4 length");
             last = Some(p);

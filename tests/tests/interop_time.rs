@@ -82,7 +82,7 @@ fn python_time_producer_frames_decode_to_the_same_time() {
     let frames = python_frames(&stamps);
     assert_eq!(frames.len(), cases.len(), "{frames:?}");
     let mut consumer = TimeConsumer::new();
-    let producer = TimeProducer::new(core::time::Duration::ZERO);
+    let producer = TimeProducer::new(None);
     for (frame, &(stamp, unix_ms, iso)) in frames.iter().zip(cases) {
         let expected = TimeOfDay::from_unix_millis(unix_ms).unwrap();
         assert_eq!(expected.to_string(), iso);

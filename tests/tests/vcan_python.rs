@@ -19,8 +19,9 @@ use std::time::{Duration, Instant};
 use eds2rust_runtime::blocking::{self, SdoClient};
 use eds2rust_runtime::heartbeat::HeartbeatProducer;
 use eds2rust_runtime::nmt::{NmtSlave, NmtSlaveEvent, NmtState};
+use eds2rust_runtime::od::standard::EventTimer;
 use eds2rust_runtime::od::{AccessRight, NodeId};
-use eds2rust_runtime::pdo::{PdoTransmitter, TransmitterConfig};
+use eds2rust_runtime::pdo::{PdoCobId, PdoTransmitter, TransmissionType, TransmitterConfig};
 use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::client::{ClientConfig, Method};
 use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
@@ -363,7 +364,7 @@ fn python_nmt_master_commands_our_slave() {
         let mut nmt = NmtSlave::new(node);
         nmt.boot_complete();
         while nmt.poll_event().is_some() {}
-        let mut heartbeat = HeartbeatProducer::new(node, Duration::from_millis(100));
+        let mut heartbeat = HeartbeatProducer::new(node, Some(Duration::from_millis(100)));
         heartbeat.set_state(nmt.state());
         heartbeat.start(clock.now());
         let mut device = Device { nmt, heartbeat };
@@ -463,8 +464,8 @@ fn our_pdo_transmitter_decoded_by_python_tpdo_map() {
     // TPDO1 of node 8 (0x180 + 8), event-driven (255), sent again every
     // 50 ms. Statusword 0x0237, position -1000 (0xFFFFFC18), mode 3, each
     // little-endian in mapping order.
-    let mut config = TransmitterConfig::new(0x188, 255);
-    config.event_timer = 50;
+    let mut config = TransmitterConfig::new(PdoCobId(0x188), TransmissionType::EventDrivenProfile);
+    config.event_timer = EventTimer(50);
     let data = [0x37, 0x02, 0x18, 0xFC, 0xFF, 0xFF, 0x03];
     let bus = open(&name).set_filters(&[]).unwrap();
     let stop = Arc::new(AtomicBool::new(false));

@@ -116,7 +116,7 @@ fn open_failed(iface: &str, sys: &std::path::Path, e: &io::Error) -> String {
 /// A master on `bus` that sends nothing of its own (no boot-up, no
 /// heartbeat): only the commands' requests.
 pub fn master(bus: LiveBus) -> Master<LiveBus> {
-    Master::new(bus, master::Master::new(MASTER_NODE, Duration::ZERO))
+    Master::new(bus, master::Master::new(MASTER_NODE, None))
 }
 
 /// Gives `node` an SDO client on its default channel with `timeout` per

@@ -37,11 +37,11 @@ fn abort_code<T>(result: std::result::Result<T, blocking::Error>) -> Option<Abor
 
 /// The next TPDO1 of `node`, decoded.
 fn next_status(m: &mut Master<MasterPort>, node: NodeId) -> Result<Tpdo1Status> {
-    let cob = Tpdo1Status::can_id(node) as u16;
+    let tpdo1 = Tpdo1Status::can_id(node);
     let data = m.run_until(WallClock::now() + TIMEOUT, |event| match event {
         MasterEvent::Pdo(PdoEvent::Received {
-            cob_id, data, len, ..
-        }) if *cob_id == cob => ControlFlow::Break(data[..*len].to_vec()),
+            can_id, data, len, ..
+        }) if *can_id == tpdo1 => ControlFlow::Break(data[..*len].to_vec()),
         _ => ControlFlow::Continue(()),
     })?;
     Ok(Tpdo1Status::decode(&data)?)
@@ -51,7 +51,7 @@ fn next_status(m: &mut Master<MasterPort>, node: NodeId) -> Result<Tpdo1Status> 
 fn boots_answers_sdo_and_sends_its_tpdo() -> Result {
     let drive = node(conveyor::DEFAULT_NODE_ID);
     let mut harness = Harness::start(&Args::default(), |now| sim_device::simulator(drive, now))?;
-    let mut core = master::Master::new(node(1), Duration::ZERO);
+    let mut core = master::Master::new(node(1), None);
     core.pdo_rx.watch_pdo::<Tpdo1Status>(drive)?;
     let mut m = Master::with_clock(harness.take_port()?, core, harness.clock());
     m.start()?;

@@ -16,7 +16,8 @@ use std::time::{Duration, Instant as WallClock};
 use eds2rust_runtime::cia402;
 use eds2rust_runtime::blocking::{self, SdoClient};
 use eds2rust_runtime::od::{NodeId, Pdo as _};
-use eds2rust_runtime::pdo::PdoConfig;
+use eds2rust_runtime::od::standard::EventTimer;
+use eds2rust_runtime::pdo::{PdoConfig, TransmissionType};
 use eds2rust_runtime::pdo::blocking::configure_pdo;
 use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::client::ClientConfig;
@@ -50,12 +51,12 @@ fn configured_over_sdo_applied_and_received() {
 
     let tpdo = PdoConfig::from_pdo::<StatusPosition>(drive)
         .unwrap()
-        .with_transmission_type(255)
-        .with_event_timer(10);
+        .with_transmission_type(TransmissionType::EventDrivenProfile)
+        .with_event_timer(EventTimer(10));
     configure_pdo(&mut sdo, &tpdo).expect("TPDO2 configured");
     let rpdo = PdoConfig::from_pdo::<ControlVelocity>(drive)
         .unwrap()
-        .with_transmission_type(255);
+        .with_transmission_type(TransmissionType::EventDrivenProfile);
     configure_pdo(&mut sdo, &rpdo).expect("RPDO1 configured");
     assert_eq!(sdo.upload(0x1A01, 0).unwrap(), [3]);
     assert_eq!(sdo.upload(0x1A01, 1).unwrap(), 0x6041_0010u32.to_le_bytes());
@@ -77,20 +78,19 @@ fn configured_over_sdo_applied_and_received() {
         control: cia402::Controlword::from_command(cia402::Command::EnableOperation).into(),
         velocity: -2500,
     };
-    let id = ControlVelocity::can_id(drive) as u16;
     watch
-        .send(&Frame::new(CanId::Standard(id), &command.encode()).unwrap())
+        .send(&Frame::new(ControlVelocity::can_id(drive), &command.encode()).unwrap())
         .unwrap();
     assert_eq!(sdo.read::<od::Controlword>().unwrap(), command.control);
     assert_eq!(sdo.read::<od::TargetVelocity>().unwrap(), command.velocity);
 
     // The TPDO arrives (event timer 10 ms) and decodes into the struct.
-    let id = StatusPosition::can_id(drive) as u16;
+    let status_id = StatusPosition::can_id(drive);
     let deadline = WallClock::now() + Duration::from_secs(3);
     let received = loop {
         assert!(WallClock::now() < deadline, "no TPDO2");
         if let Some(f) = watch.recv(Duration::from_millis(100)).unwrap() {
-            if f.id() == CanId::Standard(id) {
+            if f.id() == status_id {
                 break StatusPosition::decode(f.data()).unwrap();
             }
         }
@@ -134,7 +134,7 @@ fn configured_over_sdo_applied_and_received() {
     assert_eq!(tpdo2["enabled"], Value::Bool(true), "{tpdo2}");
     assert_eq!(
         tpdo2["cob_id"].as_u64(),
-        StatusPosition::default_cob_id(drive).map(u64::from)
+        StatusPosition::default_cob_id(drive).map(|cob| u64::from(cob.to_raw()))
     );
     let mapped: Vec<u32> = tpdo2["map"]
         .as_array()

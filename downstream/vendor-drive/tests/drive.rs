@@ -1,5 +1,6 @@
 //! The generated API as a user sees it: typed entries and PDO structs.
 
+use eds2rust_runtime::CanId;
 use eds2rust_runtime::cia402;
 use eds2rust_runtime::od::{Entry, NodeId, Pdo};
 use vendor_drive::drive::{od, pdo};
@@ -30,7 +31,10 @@ fn tpdo1_decodes_statusword_mode_and_timestamp() {
     assert_eq!(tpdo.encode(), frame);
     assert!(pdo::Tpdo1::decode(&frame[..6]).is_err());
     let node = NodeId::new(3).unwrap();
-    assert_eq!(pdo::Tpdo1::default_cob_id(node).unwrap() & 0x7FF, 0x183);
+    assert_eq!(
+        pdo::Tpdo1::default_cob_id(node).map(|cob| cob.can_id()),
+        Some(CanId::Standard(0x183))
+    );
 }
 
 #[test]

@@ -33,7 +33,7 @@ fn main() {
     assert_eq!(LINAK_COMMAND, 0x2000_0110);
     assert_eq!(LINAK_FEEDBACK, 0x2001_0110);
     let node = NodeId::new(5).unwrap();
-    let config =
-        PdoConfig::new(PdoDirection::Tpdo, 1, 0x180 + u32::from(node.get()), &TPDO1).unwrap();
+    let cob_id = pdo::Tpdo1StatusAndPosition::cob_id(node);
+    let config = PdoConfig::new(PdoDirection::Tpdo, 1, cob_id, &TPDO1).unwrap();
     assert_eq!(config.check(), Ok(()));
 }

@@ -10,6 +10,7 @@ use std::string::String;
 use crate::cia402::session::OperationError;
 use crate::od::{self, NodeId};
 use crate::pdo::blocking::PdoConfigError;
+use crate::pdo::{PdoError, WatchError};
 use crate::sdo::SdoError;
 
 pub use super::master::LssRequestError;
@@ -96,6 +97,10 @@ pub enum Error {
     Cia402(OperationError),
     /// A PDO configuration failed (its step and the SDO error inside).
     PdoConfig(Box<PdoConfigError>),
+    /// Sending or receiving a typed PDO failed: no default COB-ID, a
+    /// receiver or transmitter that refused it, a frame of the wrong
+    /// length, or none within the time given.
+    Pdo(PdoError),
     /// The deadline of [`Master::run_until`](super::Master::run_until)
     /// passed before the awaited event.
     DeadlinePassed,
@@ -202,6 +207,7 @@ impl fmt::Display for Error {
             Error::Lss(e) => e.fmt(f),
             Error::Cia402(e) => e.fmt(f),
             Error::PdoConfig(e) => e.fmt(f),
+            Error::Pdo(e) => e.fmt(f),
             Error::DeadlinePassed => f.write_str("the deadline passed before the awaited event"),
             Error::DriverStopped { reason } => write!(
                 f,
@@ -220,6 +226,7 @@ impl std::error::Error for Error {
             Error::Lss(e) => Some(e),
             Error::Cia402(e) => Some(e),
             Error::PdoConfig(e) => Some(e),
+            Error::Pdo(e) => Some(e),
             _ => None,
         }
     }
@@ -256,6 +263,18 @@ impl From<OperationError> for Error {
 impl From<PdoConfigError> for Error {
     fn from(e: PdoConfigError) -> Error {
         Error::PdoConfig(Box::new(e))
+    }
+}
+
+impl From<PdoError> for Error {
+    fn from(e: PdoError) -> Error {
+        Error::Pdo(e)
+    }
+}
+
+impl From<WatchError> for Error {
+    fn from(e: WatchError) -> Error {
+        Error::Pdo(PdoError::Watch(e))
     }
 }
 

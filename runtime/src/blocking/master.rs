@@ -10,6 +10,7 @@ use std::vec::Vec;
 
 mod drive;
 pub(crate) mod lss;
+mod pdo;
 
 pub use drive::{DRIVE_EVENTS_KEPT, DriveHandle};
 pub use lss::LssRequestError;
@@ -21,8 +22,6 @@ use super::{
 use crate::master::{self, MasterEvent};
 use crate::nmt::{NmtCommand, NmtTarget};
 use crate::od::{self, Entry, NodeId};
-use crate::pdo::PdoConfig;
-use crate::pdo::blocking::{SdoAccess, run_steps};
 use crate::sdo::client::Method;
 use crate::sdo::typed::{self, LengthNote};
 use crate::time::Deadline;
@@ -53,7 +52,7 @@ pub const MASTER_QUEUE_CAPACITY: usize = 1024;
 ///
 /// let bus = VirtualBus::new();
 /// let monitor = bus.attach();
-/// let core = master::Master::new(NodeId::new(1).unwrap(), Duration::from_millis(100));
+/// let core = master::Master::new(NodeId::new(1).unwrap(), Some(Duration::from_millis(100)));
 /// let mut m = Master::new(bus.attach(), core);
 /// m.start()?; // boot-up message of node 1
 /// let node = NodeId::new(0x20).expect("1 to 127");
@@ -567,28 +566,6 @@ impl<B: Bus> Master<B> {
     {
         let (buf, len) = encode::<E>(value, Object::new(Some(node), E::INDEX, sub))?;
         self.download(node, E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
-    }
-
-    /// Configures a PDO of `node` as [`crate::pdo::blocking::configure_pdo`]
-    /// does (same steps and read-backs; its error is
-    /// [`Error::PdoConfig`]).
-    pub fn configure_pdo(&mut self, node: NodeId, config: &PdoConfig<'_>) -> Result<(), Error> {
-        run_steps(&mut NodeSdo { master: self, node }, config).map_err(Error::from)
-    }
-}
-
-/// One node's objects through a [`Master`], for the PDO configuration.
-struct NodeSdo<'a, B> {
-    master: &'a mut Master<B>,
-    node: NodeId,
-}
-
-impl<B: Bus> SdoAccess for NodeSdo<'_, B> {
-    fn download(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), Error> {
-        self.master.download(self.node, index, sub, data)
-    }
-    fn upload(&mut self, index: u16, sub: u8) -> Result<Vec<u8>, Error> {
-        self.master.upload(self.node, index, sub)
     }
 }
 

@@ -37,8 +37,8 @@
 //!             session.on_error_code(data.as_deref());
 //!         }
 //!         Action::Wait(until) => {
-//!             if let Ok(Some((cob_id, data, at))) = timeout_at(until, next_tpdo()).await {
-//!                 session.on_pdo(cob_id, &data, at);
+//!             if let Ok(Some((can_id, data, at))) = timeout_at(until, next_tpdo()).await {
+//!                 session.on_pdo(can_id, &data, at);
 //!             }
 //!         }
 //!         Action::Done(result) => break result,
@@ -92,10 +92,10 @@ use super::requirements::{MissingObject, Operation, has_error_code};
 use super::types::{DriveConfig, DriveError, Event, Move, Step, Write};
 use super::words::{ModeOfOperation, State, Statusword};
 use super::{Drive, object};
-use crate::Instant;
 use crate::od::ObjectInfo;
 use crate::queue::Ring;
 use crate::time::earliest;
+use crate::{CanId, Instant};
 
 mod run;
 use run::Phase;
@@ -106,8 +106,8 @@ pub const IDLE_WAIT: Duration = Duration::from_secs(1);
 /// A TPDO that carries the statusword.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub struct StatuswordPdo {
-    /// The TPDO's 11-bit identifier.
-    pub cob_id: u16,
+    /// The TPDO's identifier.
+    pub can_id: CanId,
     /// The byte offset of 0x6041 in the TPDO data.
     pub offset: usize,
 }
@@ -514,17 +514,17 @@ impl Session {
         self.finish_fault(code);
     }
 
-    /// Whether `cob_id` is the statusword TPDO.
-    pub fn is_statusword_pdo(&self, cob_id: u16) -> bool {
+    /// Whether `can_id` is the statusword TPDO.
+    pub fn is_statusword_pdo(&self, can_id: CanId) -> bool {
         self.config
             .statusword_pdo
-            .is_some_and(|pdo| pdo.cob_id == cob_id)
+            .is_some_and(|pdo| pdo.can_id == can_id)
     }
 
     /// A received TPDO; takes the statusword from the statusword TPDO and
     /// returns whether it was that one.
-    pub fn on_pdo(&mut self, cob_id: u16, data: &[u8], at: Instant) -> bool {
-        let Some(pdo) = self.config.statusword_pdo.filter(|p| p.cob_id == cob_id) else {
+    pub fn on_pdo(&mut self, can_id: CanId, data: &[u8], at: Instant) -> bool {
+        let Some(pdo) = self.config.statusword_pdo.filter(|p| p.can_id == can_id) else {
             return false;
         };
         let end = pdo.offset.saturating_add(2);

@@ -32,7 +32,7 @@ fn drain_events(master: &mut Master) -> Vec<MasterEvent> {
 
 #[test]
 fn frames_come_from_the_cores_in_turn_each_in_its_own_order() {
-    let mut m = Master::new(node(1), Duration::from_millis(100));
+    let mut m = Master::new(node(1), Some(Duration::from_millis(100)));
     m.add_sdo_client(node(5), ClientConfig::new(Channel::default_for(node(5))));
     m.start(ms(0));
     m.nmt
@@ -68,10 +68,15 @@ fn frames_come_from_the_cores_in_turn_each_in_its_own_order() {
 
 #[test]
 fn own_sync_drives_the_synchronous_rpdos_and_is_reported_on_request() {
-    let mut m = Master::new(node(1), Duration::ZERO);
-    m.sync = Some(SyncProducer::new(Duration::from_millis(10), Some(2)).unwrap());
+    let mut m = Master::new(node(1), None);
+    m.sync = Some(SyncProducer::new(Some(Duration::from_millis(10)), Some(2)).unwrap());
     // RPDO1 of node 5, synchronous cyclic every SYNC.
-    let i = m.add_pdo_tx(TransmitterConfig::new(0x205, 1)).unwrap();
+    let i = m
+        .add_pdo_tx(TransmitterConfig::new(
+            PdoCobId(0x205),
+            TransmissionType::SynchronousCyclic(1),
+        ))
+        .unwrap();
     m.set_sync_events(true);
     m.start(ms(0));
     assert_eq!(drain_frames(&mut m), ["701#00"]);
@@ -94,8 +99,8 @@ fn own_sync_drives_the_synchronous_rpdos_and_is_reported_on_request() {
 
 #[test]
 fn the_deadline_is_the_earliest_of_all_cores_and_only_due_cores_run() {
-    let mut m = Master::new(node(1), Duration::from_millis(100));
-    m.sync = Some(SyncProducer::new(Duration::from_millis(30), None).unwrap());
+    let mut m = Master::new(node(1), Some(Duration::from_millis(100)));
+    m.sync = Some(SyncProducer::new(Some(Duration::from_millis(30)), None).unwrap());
     let mut config = ClientConfig::new(Channel::default_for(node(5)));
     config.timeout = Duration::from_millis(50);
     m.add_sdo_client(node(5), config);
@@ -130,9 +135,9 @@ fn the_deadline_is_the_earliest_of_all_cores_and_only_due_cores_run() {
 
 #[test]
 fn every_core_sees_every_frame() {
-    let mut m = Master::new(node(1), Duration::ZERO);
+    let mut m = Master::new(node(1), None);
     m.consumer.monitor(node(5), Duration::from_millis(500));
-    m.pdo_rx.watch(0x185, 2, None).unwrap();
+    m.pdo_rx.watch(PdoCobId(0x185), 2, None).unwrap();
     m.add_sdo_client(node(5), ClientConfig::new(Channel::default_for(node(5))));
     m.start(ms(0));
     drain_frames(&mut m);
@@ -169,7 +174,7 @@ fn every_core_sees_every_frame() {
                 emcy: Emcy::parse(&[0x10, 0x32, 0x05, 0, 0, 0, 0, 0]).unwrap()
             }),
             MasterEvent::Pdo(PdoEvent::Received {
-                cob_id: 0x185,
+                can_id: CanId::Standard(0x185),
                 data: [0x37, 0x02, 0, 0, 0, 0, 0, 0],
                 len: 2,
                 at: ms(2)
@@ -186,12 +191,15 @@ fn every_core_sees_every_frame() {
         ]
     );
     assert_eq!(m.nmt.state(node(5)), Some(to));
-    assert_eq!(m.pdo_rx.latest_data(0x185), Some(&[0x37, 0x02][..]));
+    assert_eq!(
+        m.pdo_rx.latest_data(CanId::Standard(0x185)),
+        Some(&[0x37, 0x02][..])
+    );
 }
 
 #[test]
 fn sdo_clients_are_kept_per_node() {
-    let mut m = Master::new(node(1), Duration::ZERO);
+    let mut m = Master::new(node(1), None);
     assert!(m.sdo(node(7)).is_none());
     assert_eq!(
         m.sdo_or_default(node(7)).config().channel,
@@ -210,7 +218,7 @@ fn sdo_clients_are_kept_per_node() {
 #[test]
 fn time_frames_become_events_and_the_master_can_produce_time() {
     use crate::time_stamp::{DateTime, TimeError, TimeEvent, TimeOfDay, TimeProducer};
-    let mut m = Master::new(node(1), Duration::ZERO);
+    let mut m = Master::new(node(1), None);
     m.start(ms(0));
     drain_frames(&mut m);
     // 2026-12-02T12:34:56.789Z: 45_296_789 ms = 0x02B3_2C95, day 15_676 =
@@ -250,8 +258,8 @@ fn time_frames_become_events_and_the_master_can_produce_time() {
     assert_eq!(drain_events(&mut m), []);
 
     // A TIME producer every second, from the start.
-    let mut m = Master::new(node(1), Duration::ZERO);
-    let mut producer = TimeProducer::new(Duration::from_secs(1));
+    let mut m = Master::new(node(1), None);
+    let mut producer = TimeProducer::new(Some(Duration::from_secs(1)));
     producer.set_time(ms(0), time);
     m.time_tx = Some(producer);
     m.start(ms(0));

@@ -3,12 +3,14 @@
 //! communication parameters (0x1400–0x15FF, 0x1800–0x19FF), so that a
 //! device with 512 PDOs gets no code of its own for them.
 //!
-//! Each holds the raw value (`pub` field, `const fn from_raw`/`to_raw`) and
-//! implements [`Scalar`].
+//! Each converts from and to the raw value (`const fn from_raw`/`to_raw`)
+//! and implements [`Scalar`].
 
+use core::fmt;
 use core::time::Duration;
 
 use super::Scalar;
+use crate::CanId;
 
 macro_rules! raw_value {
     ($name:ident, $raw:ty) => {
@@ -37,11 +39,14 @@ macro_rules! raw_value {
     };
 }
 
-/// The COB-ID of a PDO (sub 1 of its communication parameter): the CAN-ID
-/// in bits 0–28 (0–10 for an 11-bit CAN-ID), bit 29 extended frame, bit 30
-/// no RTR allowed, bit 31 not valid (the PDO does not exist; its mapping
-/// may be changed).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
+/// The COB-ID entry of a PDO (sub 1 of its communication parameter), the
+/// one type for it everywhere: PDO receiver and transmitter, PDO
+/// configuration, generated and derived PDO structs. Bits 0–28 hold the
+/// CAN identifier (0–10 for an 11-bit one), bit 29 selects a 29-bit
+/// identifier (extended frame), bit 30 set means no RTR allowed, bit 31 set
+/// means the PDO is not valid (it does not exist; its mapping may be
+/// changed). [`PdoCobId::can_id`] gives the identifier on the bus.
+#[derive(Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
 pub struct PdoCobId(pub u32);
 
 raw_value!(PdoCobId, u32);
@@ -50,65 +55,126 @@ impl PdoCobId {
     const EXTENDED: u32 = 1 << 29;
     const NO_RTR: u32 = 1 << 30;
     const NOT_VALID: u32 = 1 << 31;
+    const ID_29: u32 = 0x1FFF_FFFF;
 
-    /// The CAN-ID (bits 0–28).
+    /// A valid COB-ID for `id`, RTR allowed, bit 29 set for an extended
+    /// identifier.
     #[inline]
-    pub const fn can_id(self) -> u32 {
-        self.0 & 0x1FFF_FFFF
+    pub const fn new(id: CanId) -> Self {
+        Self(0).with_can_id(id)
     }
-    /// Bit 29: a 29-bit CAN-ID.
+    /// The identifier on the bus: bits 0–28 with bit 29 set, else bits
+    /// 0–10 (bits 11–28 of an 11-bit entry are ignored here; see
+    /// [`PdoCobId::checked_can_id`]).
     #[inline]
-    pub const fn extended_frame(self) -> bool {
+    pub const fn can_id(self) -> CanId {
+        if self.is_extended() {
+            CanId::Extended(self.0 & Self::ID_29)
+        } else {
+            CanId::Standard((self.0 & 0x7FF) as u16)
+        }
+    }
+    /// The identifier on the bus; an error when bit 29 is clear but bits
+    /// 11–28 are not all zero (no 11-bit identifier).
+    #[inline]
+    pub const fn checked_can_id(self) -> Result<CanId, CobIdError> {
+        if !self.is_extended() && self.0 & 0x1FFF_F800 != 0 {
+            return Err(CobIdError::OutOfRange(self));
+        }
+        Ok(self.can_id())
+    }
+    /// Bit 29 set: a 29-bit identifier (extended frame).
+    #[inline]
+    pub const fn is_extended(self) -> bool {
         self.0 & Self::EXTENDED != 0
     }
-    /// Bit 30: no remote transmission request allowed.
+    /// Bit 30 clear: remote frames may request the PDO.
     #[inline]
-    pub const fn no_rtr(self) -> bool {
-        self.0 & Self::NO_RTR != 0
+    pub const fn rtr_allowed(self) -> bool {
+        self.0 & Self::NO_RTR == 0
     }
-    /// Bit 31: the PDO does not exist (is not valid).
+    /// Bit 31 clear: the PDO exists and is used.
     #[inline]
-    pub const fn not_valid(self) -> bool {
-        self.0 & Self::NOT_VALID != 0
+    pub const fn is_valid(self) -> bool {
+        self.0 & Self::NOT_VALID == 0
     }
-    /// The same with another CAN-ID (its low 29 bits).
+    /// The same with identifier `id` (bit 29 follows its kind).
     #[inline]
-    pub const fn with_can_id(self, can_id: u32) -> Self {
-        Self(self.0 & !0x1FFF_FFFF | can_id & 0x1FFF_FFFF)
+    pub const fn with_can_id(self, id: CanId) -> Self {
+        let flags = self.0 & (Self::NO_RTR | Self::NOT_VALID);
+        match id {
+            CanId::Standard(id) => Self(flags | (id as u32 & 0x7FF)),
+            CanId::Extended(id) => Self(flags | Self::EXTENDED | (id & Self::ID_29)),
+        }
     }
-    /// The same with bit 29 set or clear.
+    /// The same with bit 31 clear (`true`) or set (`false`).
     #[inline]
-    pub const fn with_extended_frame(self, on: bool) -> Self {
-        self.with(Self::EXTENDED, on)
+    pub const fn with_valid(self, valid: bool) -> Self {
+        self.with(Self::NOT_VALID, !valid)
     }
-    /// The same with bit 30 set or clear.
+    /// The same with bit 30 clear (`true`) or set (`false`).
     #[inline]
-    pub const fn with_no_rtr(self, on: bool) -> Self {
-        self.with(Self::NO_RTR, on)
-    }
-    /// The same with bit 31 set or clear.
-    #[inline]
-    pub const fn with_not_valid(self, on: bool) -> Self {
-        self.with(Self::NOT_VALID, on)
+    pub const fn with_rtr_allowed(self, allowed: bool) -> Self {
+        self.with(Self::NO_RTR, !allowed)
     }
     const fn with(self, bit: u32, on: bool) -> Self {
         Self(if on { self.0 | bit } else { self.0 & !bit })
     }
 }
 
+/// `0x80000185 (0x185, not valid)`: the entry, then what it says.
+impl fmt::Display for PdoCobId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{:#010X} ({}", self.0, self.can_id())?;
+        if !self.is_valid() {
+            f.write_str(", not valid")?;
+        }
+        if !self.rtr_allowed() {
+            f.write_str(", no RTR")?;
+        }
+        f.write_str(")")
+    }
+}
+
+impl fmt::Debug for PdoCobId {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "PdoCobId({:#010X})", self.0)
+    }
+}
+
+/// A PDO COB-ID entry that names no identifier.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CobIdError {
+    /// Bit 29 is clear (an 11-bit identifier) but bits 11 to 28 are not
+    /// all zero.
+    OutOfRange(PdoCobId),
+}
+
+impl fmt::Display for CobIdError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CobIdError::OutOfRange(v) => write!(
+                f,
+                "COB-ID {:#010X} has bits set between bit 11 and bit 28 but bit 29 clear; \
+                 an 11-bit identifier ends at 0x7FF (set bit 29 for a 29-bit one)",
+                v.0
+            ),
+        }
+    }
+}
+
+impl core::error::Error for CobIdError {}
+
 /// How a PDO is triggered (sub 2 of its communication parameter).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Default)]
-pub struct TransmissionType(pub u8);
-
-raw_value!(TransmissionType, u8);
-
-/// The meaning of a [`TransmissionType`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum TransmissionKind {
+pub enum TransmissionType {
     /// 0: synchronous, acyclic (sent at the SYNC after an event).
     SynchronousAcyclic,
-    /// 1–240: synchronous, every n-th SYNC.
-    Synchronous(u8),
+    /// 1–240: synchronous, every n-th SYNC (a value outside 1–240 is
+    /// not one: [`TransmissionType::from_raw`] never makes it).
+    SynchronousCyclic(u8),
+    /// 241–251: reserved.
+    Reserved(u8),
     /// 252: on RTR only, data sampled at SYNC.
     RtrSynchronous,
     /// 253: on RTR only, event-driven.
@@ -117,29 +183,55 @@ pub enum TransmissionKind {
     EventDrivenManufacturer,
     /// 255: event-driven, device-profile events.
     EventDrivenProfile,
-    /// 241–251: reserved.
-    Reserved(u8),
+}
+
+impl Default for TransmissionType {
+    /// 0, the value of an entry never written.
+    fn default() -> Self {
+        TransmissionType::SynchronousAcyclic
+    }
 }
 
 impl TransmissionType {
-    /// Event-driven, device-profile events (255).
-    pub const EVENT_DRIVEN: TransmissionType = TransmissionType(255);
-
-    /// What the value means.
-    pub const fn kind(self) -> TransmissionKind {
-        match self.0 {
-            0 => TransmissionKind::SynchronousAcyclic,
-            n @ 1..=240 => TransmissionKind::Synchronous(n),
-            252 => TransmissionKind::RtrSynchronous,
-            253 => TransmissionKind::RtrEventDriven,
-            254 => TransmissionKind::EventDrivenManufacturer,
-            255 => TransmissionKind::EventDrivenProfile,
-            n => TransmissionKind::Reserved(n),
+    /// The type of a raw entry value.
+    #[inline]
+    pub const fn from_raw(raw: u8) -> Self {
+        match raw {
+            0 => TransmissionType::SynchronousAcyclic,
+            n @ 1..=240 => TransmissionType::SynchronousCyclic(n),
+            n @ 241..=251 => TransmissionType::Reserved(n),
+            252 => TransmissionType::RtrSynchronous,
+            253 => TransmissionType::RtrEventDriven,
+            254 => TransmissionType::EventDrivenManufacturer,
+            255 => TransmissionType::EventDrivenProfile,
+        }
+    }
+    /// The raw entry value.
+    #[inline]
+    pub const fn to_raw(self) -> u8 {
+        match self {
+            TransmissionType::SynchronousAcyclic => 0,
+            TransmissionType::SynchronousCyclic(n) | TransmissionType::Reserved(n) => n,
+            TransmissionType::RtrSynchronous => 252,
+            TransmissionType::RtrEventDriven => 253,
+            TransmissionType::EventDrivenManufacturer => 254,
+            TransmissionType::EventDrivenProfile => 255,
         }
     }
     /// Whether the PDO follows SYNC (0–240, 252).
     pub const fn is_synchronous(self) -> bool {
-        matches!(self.0, 0..=240 | 252)
+        matches!(self.to_raw(), 0..=240 | 252)
+    }
+}
+
+impl Scalar for TransmissionType {
+    #[inline(always)]
+    fn to_raw(self) -> u64 {
+        u64::from(TransmissionType::to_raw(self))
+    }
+    #[inline(always)]
+    fn from_raw(raw: u64) -> Self {
+        TransmissionType::from_raw(raw as u8)
     }
 }
 
@@ -182,34 +274,90 @@ mod tests {
     use super::*;
 
     #[test]
-    fn cob_id_bits() {
+    fn cob_id_bits_follow_cia_301() {
         let cob = PdoCobId::from_raw(0x8000_0185);
-        assert!(cob.not_valid() && !cob.no_rtr() && !cob.extended_frame());
-        assert_eq!(cob.can_id(), 0x185);
-        assert_eq!(cob.with_not_valid(false).to_raw(), 0x185);
-        assert_eq!(cob.with_can_id(0x1ABC_DEF0).can_id(), 0x1ABC_DEF0);
+        assert!(!cob.is_valid() && cob.rtr_allowed() && !cob.is_extended());
+        assert_eq!(cob.can_id(), CanId::Standard(0x185));
+        assert_eq!(cob.with_valid(true).to_raw(), 0x185);
+        assert!(!PdoCobId::from_raw(0x4000_0000).rtr_allowed());
         assert_eq!(
             <PdoCobId as Scalar>::from_raw(0x4000_0000).to_raw(),
             0x4000_0000
         );
+        assert_eq!(
+            PdoCobId::from_raw(0x0000_0800).checked_can_id(),
+            Err(CobIdError::OutOfRange(PdoCobId(0x800)))
+        );
+        assert_eq!(
+            PdoCobId::from_raw(0x2000_0800).checked_can_id(),
+            Ok(CanId::Extended(0x800))
+        );
     }
 
     #[test]
-    fn transmission_types_and_timers() {
+    fn cob_id_round_trips_through_its_parts() {
+        // 11-bit: entry -> (identifier, flags) -> entry.
+        for raw in [0x0000_01A0, 0x8000_0220, 0x4000_07FF, 0xC000_0000] {
+            let cob = PdoCobId::from_raw(raw);
+            let id = cob.checked_can_id().unwrap();
+            assert!(matches!(id, CanId::Standard(_)));
+            let rebuilt = PdoCobId::new(id)
+                .with_valid(cob.is_valid())
+                .with_rtr_allowed(cob.rtr_allowed());
+            assert_eq!(rebuilt.to_raw(), raw);
+        }
+        // 29-bit.
+        for raw in [0x2000_0000, 0x3FFF_FFFF, 0xA123_4567, 0x6000_0180] {
+            let cob = PdoCobId::from_raw(raw);
+            let id = cob.checked_can_id().unwrap();
+            assert!(matches!(id, CanId::Extended(_)));
+            let rebuilt = PdoCobId::new(id)
+                .with_valid(cob.is_valid())
+                .with_rtr_allowed(cob.rtr_allowed());
+            assert_eq!(rebuilt.to_raw(), raw);
+        }
+        assert_eq!(PdoCobId::new(CanId::Extended(0x185)).to_raw(), 0x2000_0185);
+        assert_eq!(PdoCobId::new(CanId::Standard(0x185)).to_raw(), 0x185);
+    }
+
+    #[test]
+    fn cob_id_formats_entry_and_identifier() {
         assert_eq!(
-            TransmissionType(0).kind(),
-            TransmissionKind::SynchronousAcyclic
-        );
-        assert_eq!(TransmissionType(3).kind(), TransmissionKind::Synchronous(3));
-        assert_eq!(
-            TransmissionType(245).kind(),
-            TransmissionKind::Reserved(245)
+            PdoCobId::from_raw(0xC000_0185).to_string(),
+            "0xC0000185 (0x185, not valid, no RTR)"
         );
         assert_eq!(
-            TransmissionType::EVENT_DRIVEN.kind(),
-            TransmissionKind::EventDrivenProfile
+            PdoCobId::from_raw(0x2000_0185).to_string(),
+            "0x20000185 (0x00000185)"
         );
-        assert!(TransmissionType(252).is_synchronous() && !TransmissionType(254).is_synchronous());
+        assert_eq!(format!("{:?}", PdoCobId(0x185)), "PdoCobId(0x00000185)");
+    }
+
+    #[test]
+    fn transmission_types_round_trip() {
+        for raw in 0..=255u8 {
+            assert_eq!(TransmissionType::from_raw(raw).to_raw(), raw);
+        }
+        assert_eq!(
+            TransmissionType::from_raw(0),
+            TransmissionType::SynchronousAcyclic
+        );
+        assert_eq!(
+            TransmissionType::from_raw(3),
+            TransmissionType::SynchronousCyclic(3)
+        );
+        assert_eq!(
+            TransmissionType::from_raw(245),
+            TransmissionType::Reserved(245)
+        );
+        assert!(
+            TransmissionType::from_raw(252).is_synchronous()
+                && !TransmissionType::from_raw(254).is_synchronous()
+        );
+    }
+
+    #[test]
+    fn times() {
         assert_eq!(InhibitTime(15).duration(), Duration::from_micros(1500));
         assert_eq!(EventTimer(0).duration(), None);
         assert_eq!(EventTimer(100).duration(), Some(Duration::from_millis(100)));

@@ -4,7 +4,7 @@
 use core::fmt;
 use std::vec::Vec;
 
-use super::config::{Step, StepAction, read_value};
+use super::config::{ConfigAction, ConfigSession, ReadBackMismatch, Step, StepAction};
 use super::{ConfigCheckError, PdoConfig};
 use crate::blocking::{Error, SdoClient};
 use crate::sdo::{AbortCode, SdoError};
@@ -28,16 +28,7 @@ pub enum PdoConfigError {
     },
     /// A value read back differs from the one written: the device accepted
     /// the write but did not keep the value.
-    Mismatch {
-        /// The read-back step.
-        step: Step,
-        /// Its 1-based position in the plan.
-        number: usize,
-        /// Number of steps in the plan.
-        total: usize,
-        /// The bytes read back.
-        read: Vec<u8>,
-    },
+    Mismatch(ReadBackMismatch),
 }
 
 impl PdoConfigError {
@@ -45,9 +36,8 @@ impl PdoConfigError {
     pub fn step(&self) -> Option<&Step> {
         match self {
             PdoConfigError::Invalid(_) => None,
-            PdoConfigError::Transfer { step, .. } | PdoConfigError::Mismatch { step, .. } => {
-                Some(step)
-            }
+            PdoConfigError::Transfer { step, .. } => Some(step),
+            PdoConfigError::Mismatch(mismatch) => Some(&mismatch.step),
         }
     }
 
@@ -101,26 +91,7 @@ impl fmt::Display for PdoConfigError {
                 }
                 Ok(())
             }
-            PdoConfigError::Mismatch {
-                step,
-                number,
-                total,
-                read,
-            } => {
-                write!(
-                    f,
-                    "PDO configuration step {number} of {total} failed: read back {} (object {:#06X} sub {}): wrote {}, read ",
-                    step.name(),
-                    step.index(),
-                    step.sub(),
-                    step.format_value(step.value().into())
-                )?;
-                match read_value(read) {
-                    Some(value) => write!(f, "{}", step.format_value(value))?,
-                    None => write!(f, "{} bytes {read:02X?}", read.len())?,
-                }
-                f.write_str("; the device did not keep the value")
-            }
+            PdoConfigError::Mismatch(mismatch) => mismatch.fmt(f),
         }
     }
 }
@@ -130,7 +101,7 @@ impl std::error::Error for PdoConfigError {
         match self {
             PdoConfigError::Invalid(e) => Some(e),
             PdoConfigError::Transfer { error, .. } => Some(error),
-            PdoConfigError::Mismatch { .. } => None,
+            PdoConfigError::Mismatch(e) => Some(e),
         }
     }
 }
@@ -171,37 +142,43 @@ impl<B: Bus> SdoAccess for SdoClient<B> {
     }
 }
 
-/// The body of [`configure_pdo`], over any blocking SDO access.
+/// The body of [`configure_pdo`], over any blocking SDO access: a
+/// [`ConfigSession`] answered one access at a time.
 pub(crate) fn run_steps(
     client: &mut impl SdoAccess,
     config: &PdoConfig<'_>,
 ) -> Result<(), PdoConfigError> {
-    config.check()?;
-    let total = config.step_count();
-    for (i, step) in config.steps().enumerate() {
-        let number = i + 1;
-        let fail = |error| PdoConfigError::Transfer {
-            step,
-            number,
-            total,
-            error,
-        };
-        match step.action() {
-            StepAction::Write => client
-                .download(step.index(), step.sub(), step.bytes())
-                .map_err(fail)?,
-            StepAction::ReadBack => {
-                let read = client.upload(step.index(), step.sub()).map_err(fail)?;
-                if !step.matches(&read) {
-                    return Err(PdoConfigError::Mismatch {
-                        step,
-                        number,
-                        total,
-                        read,
-                    });
-                }
+    let mut session = ConfigSession::new(config)?;
+    loop {
+        match session.poll_action() {
+            ConfigAction::Write(step) => {
+                client
+                    .download(step.index(), step.sub(), step.bytes())
+                    .map_err(|e| transfer_failed(&session, step, e))?;
+                session.on_written();
             }
+            ConfigAction::ReadBack(step) => {
+                let read = client
+                    .upload(step.index(), step.sub())
+                    .map_err(|e| transfer_failed(&session, step, e))?;
+                session.on_read(&read);
+            }
+            ConfigAction::Done(result) => return result.map_err(PdoConfigError::Mismatch),
         }
     }
-    Ok(())
+}
+
+/// The error of a failed SDO access of `session`'s step in progress.
+pub(crate) fn transfer_failed(
+    session: &ConfigSession<'_>,
+    step: Step,
+    error: Error,
+) -> PdoConfigError {
+    let (number, total) = session.position();
+    PdoConfigError::Transfer {
+        step,
+        number,
+        total,
+        error,
+    }
 }

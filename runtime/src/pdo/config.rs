@@ -12,16 +12,22 @@
 //! 6. the COB-ID as configured (bit 31 clear: the PDO is valid again).
 //!
 //! Then every written value is read back, the COB-ID last.
+//!
+//! A [`ConfigSession`] runs the plan without I/O: it says which SDO access
+//! comes next and takes the answers; the blocking and the tokio master
+//! both run it.
 
 use core::fmt;
 use core::iter::FusedIterator;
 
-use super::{COB_ID_INVALID, CobId, CobIdError};
+use super::{CobIdError, PdoCobId, TransmissionType};
+use crate::od::standard::{EventTimer, InhibitTime};
 use crate::od::{self, PdoDirection};
 
+mod session;
 mod step;
 
-#[cfg(feature = "std")]
+pub use session::{ConfigAction, ConfigSession, ReadBackMismatch};
 pub(crate) use step::read_value;
 pub use step::{Step, StepAction, StepKind};
 
@@ -40,13 +46,13 @@ pub struct PdoConfig<'a> {
     /// 0x1BFF for TPDOs.
     pub mapping_index: u16,
     /// The COB-ID entry to leave the PDO with (bit 31 set keeps it disabled).
-    pub cob_id: u32,
+    pub cob_id: PdoCobId,
     /// Transmission type (sub 2), if it is to be written.
-    pub transmission_type: Option<u8>,
-    /// Inhibit time in units of 100 µs (sub 3), if it is to be written.
-    pub inhibit_time: Option<u16>,
-    /// Event timer in ms (sub 5), if it is to be written.
-    pub event_timer: Option<u16>,
+    pub transmission_type: Option<TransmissionType>,
+    /// Inhibit time (sub 3), if it is to be written.
+    pub inhibit_time: Option<InhibitTime>,
+    /// Event timer (sub 5), if it is to be written.
+    pub event_timer: Option<EventTimer>,
     /// SYNC start value (sub 6, TPDOs), if it is to be written.
     pub sync_start: Option<u8>,
     /// The mapping entries (`index << 16 | subindex << 8 | bits`), dummy
@@ -61,7 +67,7 @@ impl<'a> PdoConfig<'a> {
     pub const fn new(
         direction: PdoDirection,
         number: u16,
-        cob_id: u32,
+        cob_id: PdoCobId,
         entries: &'a [u32],
     ) -> Option<PdoConfig<'a>> {
         if number == 0 || number > 512 {
@@ -101,19 +107,19 @@ impl<'a> PdoConfig<'a> {
     }
 
     /// With the transmission type written.
-    pub const fn with_transmission_type(mut self, value: u8) -> Self {
+    pub const fn with_transmission_type(mut self, value: TransmissionType) -> Self {
         self.transmission_type = Some(value);
         self
     }
 
-    /// With the inhibit time (units of 100 µs) written.
-    pub const fn with_inhibit_time(mut self, value: u16) -> Self {
+    /// With the inhibit time written.
+    pub const fn with_inhibit_time(mut self, value: InhibitTime) -> Self {
         self.inhibit_time = Some(value);
         self
     }
 
-    /// With the event timer (ms) written.
-    pub const fn with_event_timer(mut self, value: u16) -> Self {
+    /// With the event timer written.
+    pub const fn with_event_timer(mut self, value: EventTimer) -> Self {
         self.event_timer = Some(value);
         self
     }
@@ -125,11 +131,11 @@ impl<'a> PdoConfig<'a> {
     }
 
     /// Checks what CiA 301 rules out before anything is sent: a COB-ID that
-    /// is not 11-bit, object indices outside the direction's range, more
+    /// names no identifier, object indices outside the direction's range, more
     /// than 64 entries, a mapping longer than 64 bits, an entry of length
     /// 0, a reserved transmission type, a SYNC start value above 240.
     pub fn check(&self) -> Result<(), ConfigCheckError> {
-        CobId::parse(self.cob_id)?;
+        self.cob_id.checked_can_id()?;
         let (comm, mapping) = match self.direction {
             PdoDirection::Rpdo => (0x1400..=0x15FF, 0x1600..=0x17FF),
             PdoDirection::Tpdo => (0x1800..=0x19FF, 0x1A00..=0x1BFF),
@@ -164,8 +170,8 @@ impl<'a> PdoConfig<'a> {
         }
         if let Some(value) = self.transmission_type {
             let allowed = match self.direction {
-                PdoDirection::Rpdo => matches!(value, 0..=240 | 254 | 255),
-                PdoDirection::Tpdo => matches!(value, 0..=240 | 252..=255),
+                PdoDirection::Rpdo => matches!(value.to_raw(), 0..=240 | 254 | 255),
+                PdoDirection::Tpdo => matches!(value.to_raw(), 0..=240 | 252..=255),
             };
             if !allowed {
                 return Err(ConfigCheckError::TransmissionType {
@@ -226,11 +232,14 @@ impl<'a> PdoConfig<'a> {
             )
         };
         let param = |k: usize| params.iter().flatten().nth(k).map(|s| s.with(action));
-        let cob_id = |kind| Step::new(action, kind, comm, 1, self.cob_id, 4);
+        let cob_id = |kind| Step::new(action, kind, comm, 1, self.cob_id.to_raw(), 4);
         let mapping_count = Step::new(action, StepKind::MappingCount, map, 0, count.into(), 1);
         match action {
             StepAction::Write => match j {
-                0 => Some(cob_id(StepKind::CobIdDisabled).with_value(self.cob_id | COB_ID_INVALID)),
+                0 => Some(
+                    cob_id(StepKind::CobIdDisabled)
+                        .with_value(self.cob_id.with_valid(false).to_raw()),
+                ),
                 1 => Some(Step::new(action, StepKind::MappingCleared, map, 0, 0, 1)),
                 j if j < 2 + n => Some(entry(j - 1)),
                 j if j == 2 + n => Some(mapping_count),
@@ -257,16 +266,21 @@ impl<'a> PdoConfig<'a> {
             write(
                 StepKind::TransmissionType,
                 2,
-                self.transmission_type.map(u32::from),
+                self.transmission_type.map(|t| u32::from(t.to_raw())),
                 1,
             ),
             write(
                 StepKind::InhibitTime,
                 3,
-                self.inhibit_time.map(u32::from),
+                self.inhibit_time.map(|t| u32::from(t.to_raw())),
                 2,
             ),
-            write(StepKind::EventTimer, 5, self.event_timer.map(u32::from), 2),
+            write(
+                StepKind::EventTimer,
+                5,
+                self.event_timer.map(|t| u32::from(t.to_raw())),
+                2,
+            ),
             write(StepKind::SyncStart, 6, self.sync_start.map(u32::from), 1),
         ]
     }
@@ -275,7 +289,7 @@ impl<'a> PdoConfig<'a> {
 /// What CiA 301 rules out in a [`PdoConfig`] (see [`PdoConfig::check`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum ConfigCheckError {
-    /// The COB-ID entry is not an 11-bit one.
+    /// The COB-ID entry names no identifier.
     CobId(CobIdError),
     /// The communication parameter index is outside the direction's range.
     CommunicationIndex {
@@ -310,7 +324,7 @@ pub enum ConfigCheckError {
         /// The configured direction.
         direction: PdoDirection,
         /// The configured transmission type.
-        value: u8,
+        value: TransmissionType,
     },
     /// A SYNC start value above 240.
     SyncStart(u8),
@@ -345,7 +359,8 @@ impl fmt::Display for ConfigCheckError {
             ),
             ConfigCheckError::TransmissionType { direction, value } => write!(
                 f,
-                "transmission type {value} is reserved for an {} by CiA 301",
+                "transmission type {} is reserved for an {} by CiA 301",
+                value.to_raw(),
                 ranges(direction).0
             ),
             ConfigCheckError::SyncStart(v) => {

@@ -3,6 +3,7 @@
 //! messages say what is wrong, and the constant arithmetic of its layout.
 //! Not an API of its own: only the derive's expansion names these items.
 
+use crate::od::standard::PdoCobId;
 use crate::od::{DataType, Entry};
 
 /// A condition computed at compile time, as a type: the checks below are
@@ -180,12 +181,14 @@ pub const fn push_entries<const N: usize>(
 /// The COB-ID of PDO `number` of the predefined connection set for a node
 /// (TPDO1–4: 0x180, 0x280, 0x380, 0x480 + node; RPDO1–4: 0x200, 0x300,
 /// 0x400, 0x500 + node); `None` for the PDOs above 4, which have none.
-pub const fn predefined_cob_id(tpdo: bool, number: u16, node: u8) -> Option<u32> {
+pub const fn predefined_cob_id(tpdo: bool, number: u16, node: u8) -> Option<PdoCobId> {
     if number == 0 || number > 4 {
         return None;
     }
     let base = if tpdo { 0x080 } else { 0x100 };
-    Some(base + 0x100 * number as u32 + node as u32)
+    Some(PdoCobId::from_raw(
+        base + 0x100 * number as u32 + node as u32,
+    ))
 }
 
 #[cfg(test)]
@@ -205,8 +208,8 @@ mod tests {
         let n = push_entries(&mut out, 0, Some((0x6041, 0)), 16);
         let n = push_entries(&mut out, n, None, 9);
         assert_eq!((n, out), (3, [0x6041_0010, 0x0005_0008, 0x0001_0001]));
-        assert_eq!(predefined_cob_id(true, 2, 5), Some(0x285));
-        assert_eq!(predefined_cob_id(false, 1, 5), Some(0x205));
+        assert_eq!(predefined_cob_id(true, 2, 5), Some(PdoCobId(0x285)));
+        assert_eq!(predefined_cob_id(false, 1, 5), Some(PdoCobId(0x205)));
         assert_eq!(predefined_cob_id(false, 5, 5), None);
     }
 }

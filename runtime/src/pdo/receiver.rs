@@ -3,11 +3,11 @@
 use core::fmt;
 use core::time::Duration;
 
-use super::{CobId, CobIdError};
+use super::{CobIdError, PdoCobId};
 use crate::od::{self, PdoLengthError};
 use crate::queue::Ring;
 use crate::time::earliest;
-use crate::{Frame, Instant, Service};
+use crate::{CanId, Frame, Instant, Service};
 
 /// Number of events a [`PdoReceiver`] keeps; when full, the oldest is
 /// dropped and counted ([`PdoReceiver::dropped_events`]). The last data of
@@ -19,8 +19,8 @@ pub const RECEIVER_EVENTS: usize = 16;
 pub enum PdoEvent {
     /// A watched PDO arrived with its expected length.
     Received {
-        /// The 11-bit identifier.
-        cob_id: u16,
+        /// The identifier on the bus.
+        can_id: CanId,
         /// The data bytes, zero beyond `len`.
         data: [u8; 8],
         /// The number of data bytes.
@@ -32,8 +32,8 @@ pub enum PdoEvent {
     /// data was not taken (CiA 301: "PDO not processed due to length
     /// error", EMCY 0x8210, or 0x8220 when it is too long).
     LengthError {
-        /// The 11-bit identifier.
-        cob_id: u16,
+        /// The identifier on the bus.
+        can_id: CanId,
         /// The mapped length.
         expected: usize,
         /// The received length.
@@ -42,18 +42,18 @@ pub enum PdoEvent {
     /// A watched PDO with a reception timeout did not arrive in time after
     /// its last reception. Reported once per silence.
     Timeout {
-        /// The 11-bit identifier.
-        cob_id: u16,
+        /// The identifier on the bus.
+        can_id: CanId,
     },
 }
 
 impl PdoEvent {
     /// The identifier the event concerns.
-    pub const fn cob_id(&self) -> u16 {
+    pub const fn can_id(&self) -> CanId {
         match self {
-            PdoEvent::Received { cob_id, .. }
-            | PdoEvent::LengthError { cob_id, .. }
-            | PdoEvent::Timeout { cob_id } => *cob_id,
+            PdoEvent::Received { can_id, .. }
+            | PdoEvent::LengthError { can_id, .. }
+            | PdoEvent::Timeout { can_id } => *can_id,
         }
     }
 
@@ -82,16 +82,16 @@ impl PdoEvent {
 pub enum WatchError {
     /// Every slot is taken.
     Full,
-    /// The COB-ID entry is not an 11-bit one.
+    /// The COB-ID entry names no identifier.
     CobId(CobIdError),
     /// The COB-ID entry has bit 31 set: the PDO is disabled.
-    Disabled(u32),
+    Disabled(PdoCobId),
     /// A length above 8 bytes.
     Length(usize),
     /// The generated PDO struct gives no default COB-ID.
     NoDefaultCobId,
     /// The identifier is not watched.
-    NotWatched(u16),
+    NotWatched(CanId),
 }
 
 impl fmt::Display for WatchError {
@@ -101,7 +101,7 @@ impl fmt::Display for WatchError {
             WatchError::CobId(e) => e.fmt(f),
             WatchError::Disabled(v) => write!(
                 f,
-                "COB-ID {v:#010X} has bit 31 set: the PDO is disabled and never sent"
+                "COB-ID {v} has bit 31 set: the PDO is disabled and never sent"
             ),
             WatchError::Length(n) => {
                 write!(f, "a PDO of {n} bytes; a classic CAN frame holds at most 8")
@@ -109,7 +109,7 @@ impl fmt::Display for WatchError {
             WatchError::NoDefaultCobId => {
                 f.write_str("the PDO has no default COB-ID; watch it with its COB-ID")
             }
-            WatchError::NotWatched(id) => write!(f, "COB-ID {id:#05X} is not watched"),
+            WatchError::NotWatched(id) => write!(f, "PDO identifier {id} is not watched"),
         }
     }
 }
@@ -125,7 +125,7 @@ impl From<CobIdError> for WatchError {
 /// One watched PDO.
 #[derive(Debug, Clone, Copy)]
 struct Slot {
-    cob_id: u16,
+    can_id: CanId,
     len: u8,
     timeout: Option<Duration>,
     data: [u8; 8],
@@ -136,7 +136,8 @@ struct Slot {
     timed_out: bool,
 }
 
-/// Receives up to `N` PDOs (sans-IO, no heap): each watched identifier has
+/// Receives up to `N` PDOs (sans-IO, no heap): each watched identifier
+/// (11-bit or 29-bit) has
 /// a slot with its expected length, an optional reception timeout and its
 /// last data.
 ///
@@ -168,18 +169,18 @@ impl<const N: usize> PdoReceiver<N> {
         }
     }
 
-    /// Watches the PDO with COB-ID entry `cob_id` (bit 30 is ignored),
-    /// expecting `len` data bytes; `timeout` (zero: none) reports a PDO that
-    /// stops coming. Watching a watched identifier again replaces its
-    /// settings and forgets its data.
+    /// Watches the PDO with COB-ID entry `can_id` (bit 30 is ignored),
+    /// expecting `len` data bytes; `timeout` (`None`: off) reports a PDO
+    /// that stops coming for that long. Watching a watched identifier again
+    /// replaces its settings and forgets its data.
     pub fn watch(
         &mut self,
-        cob_id: u32,
+        cob_id: PdoCobId,
         len: usize,
         timeout: Option<Duration>,
     ) -> Result<(), WatchError> {
-        let parsed = CobId::parse(cob_id)?;
-        if !parsed.valid {
+        let can_id = cob_id.checked_can_id()?;
+        if !cob_id.is_valid() {
             return Err(WatchError::Disabled(cob_id));
         }
         let len = u8::try_from(len)
@@ -187,9 +188,9 @@ impl<const N: usize> PdoReceiver<N> {
             .filter(|&l| l <= 8)
             .ok_or(WatchError::Length(len))?;
         let slot = Slot {
-            cob_id: parsed.id,
+            can_id,
             len,
-            timeout: timeout.filter(|t| !t.is_zero()),
+            timeout,
             data: [0; 8],
             received: None,
             deadline: None,
@@ -198,7 +199,7 @@ impl<const N: usize> PdoReceiver<N> {
         let position = self
             .slots
             .iter()
-            .position(|s| s.is_some_and(|s| s.cob_id == parsed.id))
+            .position(|s| s.is_some_and(|s| s.can_id == can_id))
             .or_else(|| self.slots.iter().position(Option::is_none));
         match position.and_then(|i| self.slots.get_mut(i)) {
             Some(free) => {
@@ -211,23 +212,23 @@ impl<const N: usize> PdoReceiver<N> {
 
     /// Watches the generated PDO `P` of `node` on its default COB-ID with
     /// its length [`od::Pdo::LEN`], without timeout; returns the identifier.
-    pub fn watch_pdo<P: od::Pdo>(&mut self, node: od::NodeId) -> Result<u16, WatchError> {
+    pub fn watch_pdo<P: od::Pdo>(&mut self, node: od::NodeId) -> Result<CanId, WatchError> {
         let cob_id = P::default_cob_id(node).ok_or(WatchError::NoDefaultCobId)?;
         self.watch(cob_id, P::LEN, None)?;
-        Ok(CobId::parse(cob_id)?.id)
+        Ok(cob_id.can_id())
     }
 
-    /// Sets the reception timeout of a watched identifier (zero or `None`:
-    /// none); it counts from the last reception, if there was one.
+    /// Sets the reception timeout of a watched identifier (`None`: off); it
+    /// counts from the last reception, if there was one.
     pub fn set_timeout(
         &mut self,
-        cob_id: u16,
+        can_id: CanId,
         timeout: Option<Duration>,
     ) -> Result<(), WatchError> {
         let slot = self
-            .slot_mut(cob_id)
-            .ok_or(WatchError::NotWatched(cob_id))?;
-        slot.timeout = timeout.filter(|t| !t.is_zero());
+            .slot_mut(can_id)
+            .ok_or(WatchError::NotWatched(can_id))?;
+        slot.timeout = timeout;
         slot.deadline = match (slot.timeout, slot.received) {
             (Some(t), Some(at)) if !slot.timed_out => Some(at + t),
             _ => None,
@@ -235,12 +236,12 @@ impl<const N: usize> PdoReceiver<N> {
         Ok(())
     }
 
-    /// Stops watching `cob_id`; `false` when it was not watched.
-    pub fn unwatch(&mut self, cob_id: u16) -> bool {
+    /// Stops watching `can_id`; `false` when it was not watched.
+    pub fn unwatch(&mut self, can_id: CanId) -> bool {
         match self
             .slots
             .iter_mut()
-            .find(|s| s.is_some_and(|s| s.cob_id == cob_id))
+            .find(|s| s.is_some_and(|s| s.can_id == can_id))
         {
             Some(slot) => {
                 *slot = None;
@@ -250,34 +251,34 @@ impl<const N: usize> PdoReceiver<N> {
         }
     }
 
-    /// Whether `cob_id` is watched.
-    pub fn is_watched(&self, cob_id: u16) -> bool {
-        self.slot(cob_id).is_some()
+    /// Whether `can_id` is watched.
+    pub fn is_watched(&self, can_id: CanId) -> bool {
+        self.slot(can_id).is_some()
     }
 
-    /// The last data received on `cob_id` (`None` before the first
+    /// The last data received on `can_id` (`None` before the first
     /// reception or when it is not watched).
-    pub fn latest_data(&self, cob_id: u16) -> Option<&[u8]> {
-        let slot = self.slot(cob_id)?;
+    pub fn latest_data(&self, can_id: CanId) -> Option<&[u8]> {
+        let slot = self.slot(can_id)?;
         slot.received?;
         slot.data.get(..usize::from(slot.len))
     }
 
-    /// When `cob_id` was last received with the right length.
-    pub fn last_received(&self, cob_id: u16) -> Option<Instant> {
-        self.slot(cob_id)?.received
+    /// When `can_id` was last received with the right length.
+    pub fn last_received(&self, can_id: CanId) -> Option<Instant> {
+        self.slot(can_id)?.received
     }
 
-    /// Whether the reception timeout of `cob_id` expired and no PDO came since.
-    pub fn is_timed_out(&self, cob_id: u16) -> bool {
-        self.slot(cob_id).is_some_and(|s| s.timed_out)
+    /// Whether the reception timeout of `can_id` expired and no PDO came since.
+    pub fn is_timed_out(&self, can_id: CanId) -> bool {
+        self.slot(can_id).is_some_and(|s| s.timed_out)
     }
 
-    /// The last data of `cob_id` decoded as the generated struct `P`
+    /// The last data of `can_id` decoded as the generated struct `P`
     /// (`None` before the first reception or when it is not watched; a
     /// length error when `P` does not have the watched length).
-    pub fn latest<P: od::Pdo>(&self, cob_id: u16) -> Option<Result<P, PdoLengthError>> {
-        self.latest_data(cob_id).map(P::decode)
+    pub fn latest<P: od::Pdo>(&self, can_id: CanId) -> Option<Result<P, PdoLengthError>> {
+        self.latest_data(can_id).map(P::decode)
     }
 
     /// Events dropped because the event queue was full.
@@ -285,12 +286,12 @@ impl<const N: usize> PdoReceiver<N> {
         self.events.dropped()
     }
 
-    fn slot(&self, cob_id: u16) -> Option<&Slot> {
-        self.slots.iter().flatten().find(|s| s.cob_id == cob_id)
+    fn slot(&self, can_id: CanId) -> Option<&Slot> {
+        self.slots.iter().flatten().find(|s| s.can_id == can_id)
     }
 
-    fn slot_mut(&mut self, cob_id: u16) -> Option<&mut Slot> {
-        self.slots.iter_mut().flatten().find(|s| s.cob_id == cob_id)
+    fn slot_mut(&mut self, can_id: CanId) -> Option<&mut Slot> {
+        self.slots.iter_mut().flatten().find(|s| s.can_id == can_id)
     }
 }
 
@@ -301,16 +302,14 @@ impl<const N: usize> Service for PdoReceiver<N> {
         if frame.is_remote() {
             return;
         }
-        let Some(id) = frame.cob_id() else {
-            return;
-        };
-        let Some(slot) = self.slots.iter_mut().flatten().find(|s| s.cob_id == id) else {
+        let id = frame.id();
+        let Some(slot) = self.slots.iter_mut().flatten().find(|s| s.can_id == id) else {
             return;
         };
         let expected = usize::from(slot.len);
         if frame.len() != expected {
             let event = PdoEvent::LengthError {
-                cob_id: id,
+                can_id: id,
                 expected,
                 actual: frame.len(),
             };
@@ -325,7 +324,7 @@ impl<const N: usize> Service for PdoReceiver<N> {
         slot.deadline = slot.timeout.map(|t| now + t);
         slot.timed_out = false;
         let event = PdoEvent::Received {
-            cob_id: id,
+            can_id: id,
             data: slot.data,
             len: expected,
             at: now,
@@ -339,7 +338,7 @@ impl<const N: usize> Service for PdoReceiver<N> {
                 slot.deadline = None;
                 slot.timed_out = true;
                 self.events.push(PdoEvent::Timeout {
-                    cob_id: slot.cob_id,
+                    can_id: slot.can_id,
                 });
             }
         }

@@ -3,30 +3,31 @@
 use core::fmt;
 use core::time::Duration;
 
-use super::{CobId, CobIdError};
+use super::{CobIdError, PdoCobId, TransmissionType};
 use crate::frame::FrameError;
+use crate::od::standard::{EventTimer, InhibitTime};
 use crate::sync::{DEFAULT_COB_ID as SYNC_COB_ID, parse_sync_on};
 use crate::time::earliest;
-use crate::{Frame, Instant, Service, od};
+use crate::{CanId, Frame, Instant, Service, od};
 
 /// The communication parameters of a transmitted PDO, as the values of the
 /// CiA 301 communication parameter object (0x1400.. on the receiving
 /// device).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TransmitterConfig {
-    /// The COB-ID entry: an 11-bit identifier; bit 31 set disables the PDO,
-    /// bit 30 (no RTR) is ignored.
-    pub cob_id: u32,
-    /// 0: synchronous acyclic (sent at the next SYNC after a change);
-    /// 1 to 240: synchronous cyclic (sent at every n-th SYNC); 254 and 255:
-    /// event-driven (sent when the data is set). 241 to 253 are refused.
-    pub transmission_type: u8,
-    /// Minimum time between two event-driven transmissions, in units of
-    /// 100 µs (0: none). Synchronous PDOs are paced by SYNC and ignore it.
-    pub inhibit_time: u16,
-    /// Event-driven PDOs only: the data is sent again after this many
-    /// milliseconds without a transmission (0: never).
-    pub event_timer: u16,
+    /// The COB-ID entry: bit 31 set disables the PDO, bit 30 (no RTR) is
+    /// ignored.
+    pub cob_id: PdoCobId,
+    /// Synchronous acyclic (sent at the next SYNC after a change),
+    /// synchronous cyclic (sent at every n-th SYNC), or event-driven (sent
+    /// when the data is set); the RTR-only and reserved types are refused.
+    pub transmission_type: TransmissionType,
+    /// Minimum time between two event-driven transmissions (0: none).
+    /// Synchronous PDOs are paced by SYNC and ignore it.
+    pub inhibit_time: InhibitTime,
+    /// Event-driven PDOs only: the data is sent again after this time
+    /// without a transmission ([`EventTimer::duration`]; 0 is off).
+    pub event_timer: EventTimer,
     /// The COB-ID of the SYNC frames that pace synchronous PDOs (11 bits).
     pub sync_cob_id: u16,
     /// Synchronous cyclic PDOs only: the SYNC counter value of the SYNC
@@ -38,12 +39,12 @@ pub struct TransmitterConfig {
 impl TransmitterConfig {
     /// `cob_id` with `transmission_type`, no inhibit time, no event timer,
     /// SYNC on 0x080, no SYNC start value.
-    pub const fn new(cob_id: u32, transmission_type: u8) -> TransmitterConfig {
+    pub const fn new(cob_id: PdoCobId, transmission_type: TransmissionType) -> TransmitterConfig {
         TransmitterConfig {
             cob_id,
             transmission_type,
-            inhibit_time: 0,
-            event_timer: 0,
+            inhibit_time: InhibitTime(0),
+            event_timer: EventTimer(0),
             sync_cob_id: SYNC_COB_ID,
             sync_start: 0,
         }
@@ -51,23 +52,21 @@ impl TransmitterConfig {
 
     /// The configuration of `P` for `node`: its default COB-ID with
     /// `transmission_type`; `None` when `P` has no default COB-ID.
-    pub fn from_pdo<P: od::Pdo>(node: od::NodeId, transmission_type: u8) -> Option<Self> {
+    pub fn from_pdo<P: od::Pdo>(
+        node: od::NodeId,
+        transmission_type: TransmissionType,
+    ) -> Option<Self> {
         P::default_cob_id(node).map(|cob_id| TransmitterConfig::new(cob_id, transmission_type))
-    }
-
-    /// The inhibit time as a duration.
-    pub const fn inhibit_duration(&self) -> Duration {
-        Duration::from_micros(self.inhibit_time as u64 * 100)
     }
 }
 
 /// A transmitter configuration this engine cannot run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum TransmitterConfigError {
-    /// The COB-ID entry is not an 11-bit one.
+    /// The COB-ID entry names no identifier.
     CobId(CobIdError),
     /// A transmission type other than 0 to 240, 254 or 255.
-    TransmissionType(u8),
+    TransmissionType(TransmissionType),
     /// A SYNC start value above 240.
     SyncStart(u8),
     /// A SYNC COB-ID above 0x7FF.
@@ -80,8 +79,9 @@ impl fmt::Display for TransmitterConfigError {
             TransmitterConfigError::CobId(e) => e.fmt(f),
             TransmitterConfigError::TransmissionType(t) => write!(
                 f,
-                "transmission type {t} is not supported: use 0 (synchronous acyclic), 1 to 240 \
-                 (synchronous cyclic), 254 or 255 (event-driven)"
+                "transmission type {} is not supported: use 0 (synchronous acyclic), 1 to 240 \
+                 (synchronous cyclic), 254 or 255 (event-driven)",
+                t.to_raw()
             ),
             TransmitterConfigError::SyncStart(v) => {
                 write!(
@@ -138,7 +138,7 @@ enum Mode {
 #[derive(Debug, Clone)]
 pub struct PdoTransmitter {
     config: TransmitterConfig,
-    cob_id: CobId,
+    can_id: CanId,
     mode: Mode,
     data: [u8; 8],
     len: u8,
@@ -158,14 +158,17 @@ pub struct PdoTransmitter {
 }
 
 impl PdoTransmitter {
-    /// A transmitter with `config`; it refuses 29-bit COB-IDs, reserved and
-    /// RTR-only transmission types (241 to 253) and SYNC start values above 240.
+    /// A transmitter with `config`; it refuses COB-IDs that name no
+    /// identifier, reserved and RTR-only transmission types (241 to 253)
+    /// and SYNC start values above 240.
     pub fn new(config: TransmitterConfig) -> Result<PdoTransmitter, TransmitterConfigError> {
-        let cob_id = CobId::parse(config.cob_id)?;
+        let can_id = config.cob_id.checked_can_id()?;
         let mode = match config.transmission_type {
-            0 => Mode::SyncAcyclic,
-            n @ 1..=240 => Mode::SyncCyclic(n),
-            254 | 255 => Mode::Event,
+            TransmissionType::SynchronousAcyclic => Mode::SyncAcyclic,
+            TransmissionType::SynchronousCyclic(n @ 1..=240) => Mode::SyncCyclic(n),
+            TransmissionType::EventDrivenManufacturer | TransmissionType::EventDrivenProfile => {
+                Mode::Event
+            }
             other => return Err(TransmitterConfigError::TransmissionType(other)),
         };
         if config.sync_start > 240 {
@@ -176,7 +179,7 @@ impl PdoTransmitter {
         }
         Ok(PdoTransmitter {
             config,
-            cob_id,
+            can_id,
             mode,
             data: [0; 8],
             len: 0,
@@ -195,14 +198,19 @@ impl PdoTransmitter {
         &self.config
     }
 
-    /// The COB-ID.
-    pub const fn cob_id(&self) -> CobId {
-        self.cob_id
+    /// The COB-ID entry.
+    pub const fn cob_id(&self) -> PdoCobId {
+        self.config.cob_id
+    }
+
+    /// The identifier the PDO is sent on.
+    pub const fn can_id(&self) -> CanId {
+        self.can_id
     }
 
     /// Whether the PDO is enabled (COB-ID bit 31 clear).
     pub const fn is_enabled(&self) -> bool {
-        self.cob_id.valid
+        self.config.cob_id.is_valid()
     }
 
     /// The current data (empty before the first [`PdoTransmitter::set_data`]).
@@ -253,12 +261,12 @@ impl PdoTransmitter {
     /// (anything scheduled is dropped); clearing it enables the PDO again:
     /// the SYNC count restarts, and an event-driven PDO with data starts its
     /// event timer.
-    pub fn set_cob_id(&mut self, now: Instant, cob_id: u32) -> Result<(), CobIdError> {
-        let parsed = CobId::parse(cob_id)?;
+    pub fn set_cob_id(&mut self, now: Instant, cob_id: PdoCobId) -> Result<(), CobIdError> {
+        let can_id = cob_id.checked_can_id()?;
         let was_enabled = self.is_enabled();
-        self.cob_id = parsed;
+        self.can_id = can_id;
         self.config.cob_id = cob_id;
-        if !parsed.valid {
+        if !cob_id.is_valid() {
             self.outbox = None;
             self.changed = false;
             self.deferred = false;
@@ -272,8 +280,8 @@ impl PdoTransmitter {
             }
         } else if let Some(frame) = self.outbox {
             // The waiting frame goes out on the new identifier.
-            self.outbox = Some(Frame::standard(
-                parsed.id,
+            self.outbox = Some(Frame::with_id(
+                can_id,
                 *frame.data_padded(),
                 frame.len() as u8,
             ));
@@ -282,8 +290,7 @@ impl PdoTransmitter {
     }
 
     fn event_timer(&self) -> Option<Duration> {
-        (self.config.event_timer != 0)
-            .then(|| Duration::from_millis(u64::from(self.config.event_timer)))
+        self.config.event_timer.duration()
     }
 
     fn inhibited(&self, now: Instant) -> bool {
@@ -297,7 +304,7 @@ impl PdoTransmitter {
             for (d, s) in data.iter_mut().zip(self.data()) {
                 *d = *s;
             }
-            self.outbox = Some(Frame::standard(self.cob_id.id, data, self.len));
+            self.outbox = Some(Frame::with_id(self.can_id, data, self.len));
         }
     }
 
@@ -306,7 +313,7 @@ impl PdoTransmitter {
     fn transmit(&mut self, now: Instant) {
         self.queue_frame();
         self.deferred = false;
-        let inhibit = self.config.inhibit_duration();
+        let inhibit = self.config.inhibit_time.duration();
         self.inhibit_until = (!inhibit.is_zero()).then(|| now + inhibit);
         self.event_due = self.event_timer().map(|t| now + t);
     }

@@ -4,9 +4,12 @@ use core::fmt;
 use core::time::Duration;
 
 use super::{DEFAULT_COB_ID, TimeError, TimeOfDay};
-use crate::heartbeat::next_period;
+use crate::heartbeat::{at_least, next_period};
 use crate::queue::Ring;
 use crate::{CanId, Frame, Instant, Service};
+
+/// The shortest TIME period: 1 ms, the resolution of TIME_OF_DAY.
+const MIN_PERIOD: Duration = Duration::from_millis(1);
 
 /// Object 0x1012 "COB-ID time stamp": whether the node consumes and
 /// produces TIME, and the identifier (11-bit or 29-bit).
@@ -136,7 +139,7 @@ pub fn time_frame(id: CanId, time: TimeOfDay) -> Frame {
 #[derive(Debug, Clone)]
 pub struct TimeProducer {
     id: CanId,
-    period: Duration,
+    period: Option<Duration>,
     running: bool,
     next: Option<Instant>,
     reference: Option<(Instant, TimeOfDay)>,
@@ -148,7 +151,7 @@ impl Default for TimeProducer {
     fn default() -> Self {
         TimeProducer {
             id: CanId::Standard(DEFAULT_COB_ID),
-            period: Duration::ZERO,
+            period: None,
             running: false,
             next: None,
             reference: None,
@@ -159,20 +162,21 @@ impl Default for TimeProducer {
 }
 
 impl TimeProducer {
-    /// A stopped producer on 0x100 with period `period` (zero: only
-    /// [`TimeProducer::send`] and [`TimeProducer::send_now`] send).
-    pub fn new(period: Duration) -> TimeProducer {
+    /// A stopped producer on 0x100 with period `period` (`None`: only
+    /// [`TimeProducer::send`] and [`TimeProducer::send_now`] send; a period
+    /// below 1 ms, the resolution of TIME, counts as 1 ms).
+    pub fn new(period: Option<Duration>) -> TimeProducer {
         TimeProducer {
-            period,
+            period: at_least(period, MIN_PERIOD),
             ..TimeProducer::default()
         }
     }
 
     /// A stopped producer on `id` (11-bit or 29-bit).
-    pub fn with_id(id: CanId, period: Duration) -> Result<TimeProducer, TimeConfigError> {
+    pub fn with_id(id: CanId, period: Option<Duration>) -> Result<TimeProducer, TimeConfigError> {
         Ok(TimeProducer {
             id: checked_id(id)?,
-            period,
+            period: at_least(period, MIN_PERIOD),
             ..TimeProducer::default()
         })
     }
@@ -182,8 +186,8 @@ impl TimeProducer {
         self.id
     }
 
-    /// The period of the periodic TIME (zero: none).
-    pub const fn period(&self) -> Duration {
+    /// The period of the periodic TIME (`None`: none).
+    pub const fn period(&self) -> Option<Duration> {
         self.period
     }
 
@@ -233,7 +237,7 @@ impl TimeProducer {
     /// Starts the periodic TIME: the first one is due at `now`.
     pub fn start(&mut self, now: Instant) {
         self.running = true;
-        self.next = (!self.period.is_zero()).then_some(now);
+        self.next = self.period.map(|_| now);
     }
 
     /// Stops the periodic TIME (a frame not yet polled is discarded).
@@ -244,11 +248,11 @@ impl TimeProducer {
     }
 
     /// Changes the period; when running, the next TIME is due one new
-    /// period after `now` (zero pauses the periodic TIME).
-    pub fn set_period(&mut self, now: Instant, period: Duration) {
-        self.period = period;
+    /// period after `now` (`None` pauses the periodic TIME).
+    pub fn set_period(&mut self, now: Instant, period: Option<Duration>) {
+        self.period = at_least(period, MIN_PERIOD);
         if self.running {
-            self.next = (!period.is_zero()).then(|| now + period);
+            self.next = self.period.map(|period| now + period);
         }
     }
 }
@@ -270,7 +274,7 @@ impl Service for TimeProducer {
         if due > now {
             return;
         }
-        self.next = Some(next_period(due, now, self.period));
+        self.next = self.period.map(|period| next_period(due, now, period));
         if self.send_now(now).is_none() {
             self.skipped = self.skipped.saturating_add(1);
         }

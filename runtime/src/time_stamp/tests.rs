@@ -346,7 +346,7 @@ fn events<S: Service>(s: &mut S) -> Vec<S::Event> {
 #[test]
 fn producer_sends_given_and_periodic_times() {
     let t = civil(2026, 12, 2, 12, 34, 56, 789);
-    let mut p = TimeProducer::new(Duration::from_secs(1));
+    let mut p = TimeProducer::new(Some(Duration::from_secs(1)));
     p.send(TimeOfDay::EPOCH);
     p.send(t);
     // The newer time replaces the one not yet polled.
@@ -391,7 +391,7 @@ fn producer_sends_given_and_periodic_times() {
 
 #[test]
 fn producer_on_a_29_bit_identifier() {
-    let mut p = TimeProducer::with_id(CanId::Extended(0x1234_5678), Duration::ZERO).unwrap();
+    let mut p = TimeProducer::with_id(CanId::Extended(0x1234_5678), None).unwrap();
     p.send(TimeOfDay::EPOCH);
     assert_eq!(
         frames(&mut p),
@@ -400,7 +400,7 @@ fn producer_on_a_29_bit_identifier() {
     p.start(ms(0));
     assert_eq!(p.poll_timeout(), None);
     assert_eq!(
-        TimeProducer::with_id(CanId::Standard(0x800), Duration::ZERO).err(),
+        TimeProducer::with_id(CanId::Standard(0x800), None).err(),
         Some(TimeConfigError::Id(CanId::Standard(0x800)))
     );
     assert_eq!(

@@ -13,6 +13,7 @@ use ::tokio::sync::{Notify, oneshot};
 mod drive;
 mod driver;
 mod lss;
+mod pdo;
 mod sdo;
 mod stream;
 mod streamed;
@@ -23,12 +24,13 @@ pub use driver::Driver;
 pub use stream::{Events, PDO_QUEUE_CAPACITY, Pdos};
 
 use super::Error;
+use crate::CanId;
 use crate::blocking::{Upload, transfer_end};
 use crate::lss::LssEvent;
 use crate::master::{self, MasterEvent};
 use crate::nmt::{NmtCommand, NmtTarget};
 use crate::od::{self, NodeId};
-use crate::pdo::{CobId, PdoEvent, WatchError};
+use crate::pdo::{PdoCobId, PdoEvent, WatchError};
 use crate::sdo::typed::LengthNote;
 use crate::transport::{AsyncBus, Clock};
 use crate::{Instant, Service};
@@ -95,7 +97,7 @@ use stream::Queue;
 /// # async fn main() -> Result<(), Box<dyn std::error::Error>> {
 /// let bus = VirtualBus::new();
 /// let monitor = bus.attach();
-/// let core = master::Master::new(NodeId::new(1).unwrap(), Duration::from_millis(100));
+/// let core = master::Master::new(NodeId::new(1).unwrap(), Some(Duration::from_millis(100)));
 /// let (m, driver) = Master::new(bus.attach(), core);
 /// let driver = tokio::spawn(driver.run());
 /// m.start().await?; // boot-up message of node 1
@@ -152,7 +154,7 @@ struct State {
     /// SDO transfers with one node take turns.
     turns: BTreeMap<NodeId, Arc<::tokio::sync::Mutex<()>>>,
     events: Vec<Arc<Queue<MasterEvent>>>,
-    pdos: Vec<(u16, Arc<Queue<PdoEvent>>)>,
+    pdos: Vec<(CanId, Arc<Queue<PdoEvent>>)>,
     notes: VecDeque<(NodeId, LengthNote)>,
     unobserved: u64,
     handles: usize,
@@ -255,7 +257,7 @@ impl State {
             MasterEvent::Pdo(e) => {
                 if !matches!(e, PdoEvent::Timeout { .. }) {
                     self.pdos.retain(|(_, q)| Arc::strong_count(q) > 1);
-                    for (_, queue) in self.pdos.iter().filter(|(id, _)| *id == e.cob_id()) {
+                    for (_, queue) in self.pdos.iter().filter(|(id, _)| *id == e.can_id()) {
                         queue.push(e);
                     }
                 }
@@ -435,14 +437,14 @@ impl Master {
     /// default COB-ID (see [`Pdos`]). The PDO receiver watches it with
     /// length [`od::Pdo::LEN`] unless it already watches that COB-ID (then
     /// its settings stay).
-    pub fn pdos<P: od::Pdo>(&self, node: NodeId) -> Result<Pdos<P>, WatchError> {
-        let cob_id = P::default_cob_id(node).ok_or(WatchError::NoDefaultCobId)?;
+    pub fn pdos<P: od::Pdo>(&self, node: NodeId) -> Result<Pdos<P>, Error> {
+        let cob_id = crate::pdo::default_cob_id::<P>(node)?;
         self.pdos_on::<P>(cob_id)
     }
 
     /// [`Master::pdos`] on the COB-ID entry `cob_id` (bit 30 ignored).
-    pub fn pdos_on<P: od::Pdo>(&self, cob_id: u32) -> Result<Pdos<P>, WatchError> {
-        let id = CobId::parse(cob_id)?.id;
+    pub fn pdos_on<P: od::Pdo>(&self, cob_id: PdoCobId) -> Result<Pdos<P>, Error> {
+        let id = cob_id.checked_can_id().map_err(WatchError::from)?;
         let queue = Arc::new(Queue::new(PDO_QUEUE_CAPACITY));
         let mut state = self.shared.lock();
         if !state.core.pdo_rx.is_watched(id) {
@@ -456,7 +458,7 @@ impl Master {
         drop(state);
         self.shared.wake.notify_one();
         Ok(Pdos {
-            cob_id: id,
+            can_id: id,
             queue,
             pdo: PhantomData,
         })

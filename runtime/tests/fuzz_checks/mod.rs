@@ -312,7 +312,11 @@ pub fn pdo_receiver(data: &[u8]) {
     let mut receiver: PdoReceiver<4> = PdoReceiver::new();
     for (cob, len) in [(0x181u32, 8usize), (0x281, 2), (0x1A0, 0)] {
         receiver
-            .watch(cob, len, Some(Duration::from_millis(100)))
+            .watch(
+                eds2rust_runtime::pdo::PdoCobId(cob),
+                len,
+                Some(Duration::from_millis(100)),
+            )
             .expect("a valid COB-ID");
     }
     feed(&mut receiver, &frames(data), |_, _| {});

@@ -4,8 +4,6 @@
 //! scenario in `main.rs` is written once against [`Rig`]; each rig only
 //! forwards to the runtime's drive helper.
 
-use std::time::Duration;
-
 use eds2rust_runtime::Instant;
 use eds2rust_runtime::blocking;
 use eds2rust_runtime::cia402::{Event, Request, SessionConfig, State};
@@ -34,7 +32,7 @@ pub trait Rig {
 
 /// A core master as node `me`, without heartbeat of its own.
 pub fn core(me: NodeId) -> master::Master {
-    master::Master::new(me, Duration::ZERO)
+    master::Master::new(me, None)
 }
 
 /// The blocking master's drive handle.

@@ -4,7 +4,9 @@
 //! 0, 1–240, 254, 255 with inhibit time and event timer); RPDOs are
 //! unpacked into the mapped entries.
 
-use eds2rust_runtime::pdo::{PdoTransmitter, TransmitterConfig};
+use eds2rust_runtime::CanId;
+use eds2rust_runtime::od::standard::{EventTimer, InhibitTime};
+use eds2rust_runtime::pdo::{PdoCobId, PdoTransmitter, TransmissionType, TransmitterConfig};
 
 use crate::store::ObjectTable;
 
@@ -42,7 +44,7 @@ pub(crate) struct Tpdo {
 /// An RPDO the device listens to.
 #[derive(Debug)]
 pub(crate) struct Rpdo {
-    pub(crate) cob_id: u16,
+    pub(crate) can_id: CanId,
     pub(crate) synchronous: bool,
     pub(crate) mapping: Vec<Mapped>,
     /// Data of a synchronous RPDO, applied at the next SYNC.
@@ -73,14 +75,15 @@ pub(crate) fn tpdos(table: &ObjectTable, sync_cob_id: u16) -> Vec<Tpdo> {
         .filter(|n| table.has_index(0x1800 + n))
         .filter_map(|n| {
             let comm = 0x1800 + n;
-            let cob_id = table.get_uint(comm, 1)? as u32;
-            if cob_id & 0x8000_0000 != 0 {
+            let cob_id = PdoCobId(table.get_uint(comm, 1)? as u32);
+            if !cob_id.is_valid() {
                 return None;
             }
+            let transmission = table.get_uint(comm, 2).unwrap_or(255) as u8;
             let mut config =
-                TransmitterConfig::new(cob_id, table.get_uint(comm, 2).unwrap_or(255) as u8);
-            config.inhibit_time = table.get_uint(comm, 3).unwrap_or(0) as u16;
-            config.event_timer = table.get_uint(comm, 5).unwrap_or(0) as u16;
+                TransmitterConfig::new(cob_id, TransmissionType::from_raw(transmission));
+            config.inhibit_time = InhibitTime(table.get_uint(comm, 3).unwrap_or(0) as u16);
+            config.event_timer = EventTimer(table.get_uint(comm, 5).unwrap_or(0) as u16);
             config.sync_start = table.get_uint(comm, 6).unwrap_or(0) as u8;
             config.sync_cob_id = sync_cob_id;
             let tx = PdoTransmitter::new(config).ok()?;
@@ -99,13 +102,13 @@ pub(crate) fn rpdos(table: &ObjectTable) -> Vec<Rpdo> {
         .filter(|n| table.has_index(0x1400 + n))
         .filter_map(|n| {
             let comm = 0x1400 + n;
-            let cob_id = table.get_uint(comm, 1)? as u32;
-            if cob_id & 0x8000_0000 != 0 || cob_id & 0x2000_0000 != 0 {
+            let cob_id = PdoCobId(table.get_uint(comm, 1)? as u32);
+            if !cob_id.is_valid() {
                 return None;
             }
             let transmission = table.get_uint(comm, 2).unwrap_or(255);
             Some(Rpdo {
-                cob_id: (cob_id & 0x7FF) as u16,
+                can_id: cob_id.checked_can_id().ok()?,
                 synchronous: transmission <= 240,
                 mapping: mapping(table, 0x1600 + n),
                 pending: None,

@@ -419,9 +419,9 @@ impl LinakTechline {
         use eds2rust_runtime::od::standard::TransmissionType as Type;
         use od::rpdo1_communication_parameter::TransmissionType;
         use od::tpdo2_communication_parameter::CobIdUsedByTpdo;
-        ctx.set::<TransmissionType>(Type::EVENT_DRIVEN);
+        ctx.set::<TransmissionType>(Type::EventDrivenProfile);
         if let Some(cob) = ctx.get::<CobIdUsedByTpdo>() {
-            ctx.set::<CobIdUsedByTpdo>(cob.with_not_valid(true));
+            ctx.set::<CobIdUsedByTpdo>(cob.with_valid(false));
         }
         self.publish(ctx, true);
     }

@@ -477,14 +477,16 @@ fn default_cob_id_fn(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> 
         }),
     };
     quote! {
-        #[inline] fn default_cob_id(node_id: #rt::od::NodeId) -> ::core::option::Option<u32> {
+        #[inline] fn default_cob_id(node_id: #rt::od::NodeId) -> ::core::option::Option<#rt::od::standard::PdoCobId> {
             #body
         }
     }
 }
 
 /// `cob_id(node_id)`/`can_id(node_id)` for a `$NODEID`-relative default,
-/// `COB_ID`/`CAN_ID` for a fixed one, nothing without a default.
+/// `COB_ID`/`CAN_ID` for a fixed one, nothing without a default: the COB-ID
+/// entry as the runtime's `od::standard::PdoCobId`, the identifier on the
+/// bus as its `CanId`.
 fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> TokenStream {
     let Some(literal) = default else {
         return TokenStream::new();
@@ -495,12 +497,6 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
     let Ok(value) = u32::try_from(value) else {
         return TokenStream::new();
     };
-    let id_mask = if value & (1 << 29) != 0 {
-        0x1FFF_FFFFu32
-    } else {
-        0x7FF
-    };
-    let id_mask = prim::hex(u128::from(id_mask));
     let value_lit = prim::hex(u128::from(value));
     let text = docs::text(&literal.text);
     if literal.plus_node_id {
@@ -509,12 +505,12 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
         );
         quote! {
             #[doc = #doc]
-            #[inline] pub const fn cob_id(node_id: #rt::od::NodeId) -> u32 {
-                #value_lit + node_id.get() as u32
+            #[inline] pub const fn cob_id(node_id: #rt::od::NodeId) -> #rt::od::standard::PdoCobId {
+                #rt::od::standard::PdoCobId::from_raw(#value_lit + node_id.get() as u32)
             }
             #[doc = " The CAN identifier of the default COB-ID for a node."]
-            #[inline] pub const fn can_id(node_id: #rt::od::NodeId) -> u32 {
-                Self::cob_id(node_id) & #id_mask
+            #[inline] pub const fn can_id(node_id: #rt::od::NodeId) -> #rt::CanId {
+                Self::cob_id(node_id).can_id()
             }
         }
     } else {
@@ -523,9 +519,9 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
         );
         quote! {
             #[doc = #doc]
-            pub const COB_ID: u32 = #value_lit;
+            pub const COB_ID: #rt::od::standard::PdoCobId = #rt::od::standard::PdoCobId::from_raw(#value_lit);
             #[doc = " The CAN identifier of the default COB-ID."]
-            pub const CAN_ID: u32 = #value_lit & #id_mask;
+            pub const CAN_ID: #rt::CanId = Self::COB_ID.can_id();
         }
     }
 }

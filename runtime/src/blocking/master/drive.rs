@@ -57,7 +57,7 @@ impl<B: Bus> Master<B> {
     ///     ObjectInfo::new(0x6041, 0, "Statusword", DataType::Unsigned16, AccessRight::Ro, true),
     /// ];
     /// # let bus = VirtualBus::new();
-    /// # let core = master::Master::new(NodeId::new(1).unwrap(), Duration::from_millis(100));
+    /// # let core = master::Master::new(NodeId::new(1).unwrap(), Some(Duration::from_millis(100)));
     /// let mut m = Master::new(bus.attach(), core);
     /// let node = NodeId::new(0x20).unwrap();
     /// let config = SessionConfig::default().with_required(&[Operation::ProfileVelocity]);
@@ -129,18 +129,18 @@ impl<B: Bus> Master<B> {
                 Action::Wait(until) => {
                     let pdo = self.run_until(until, |event| match event {
                         MasterEvent::Pdo(PdoEvent::Received {
-                            cob_id,
+                            can_id,
                             data,
                             len,
                             at,
-                        }) if session.is_statusword_pdo(*cob_id) => {
-                            ControlFlow::Break((*cob_id, *data, *len, *at))
+                        }) if session.is_statusword_pdo(*can_id) => {
+                            ControlFlow::Break((*can_id, *data, *len, *at))
                         }
                         _ => ControlFlow::Continue(()),
                     });
                     match pdo {
-                        Ok((cob_id, data, len, at)) => {
-                            session.on_pdo(cob_id, data.get(..len).unwrap_or(&[]), at);
+                        Ok((can_id, data, len, at)) => {
+                            session.on_pdo(can_id, data.get(..len).unwrap_or(&[]), at);
                         }
                         Err(Error::DeadlinePassed) => {}
                         Err(e) => return Err(e),

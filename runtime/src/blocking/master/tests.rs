@@ -18,7 +18,7 @@ fn node(id: u8) -> NodeId {
 fn rig() -> (Master<VirtualPort>, VirtualPort, VirtualBus) {
     let bus = VirtualBus::new();
     let monitor = bus.attach();
-    let mut m = Master::new(bus.attach(), master::Master::new(node(1), PERIOD));
+    let mut m = Master::new(bus.attach(), master::Master::new(node(1), Some(PERIOD)));
     m.start().unwrap();
     (m, monitor, bus)
 }

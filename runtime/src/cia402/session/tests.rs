@@ -138,5 +138,5 @@ fn wrong_statusword_length_ends_the_request() {
         session.poll_action(later),
         Action::Wait(now + Duration::from_millis(10))
     );
-    assert!(!session.on_pdo(0x181, &[0x37, 0x02], later));
+    assert!(!session.on_pdo(CanId::Standard(0x181), &[0x37, 0x02], later));
 }

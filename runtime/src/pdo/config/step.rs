@@ -2,7 +2,7 @@
 
 use core::fmt;
 
-use crate::pdo::{COB_ID_INVALID, COB_ID_NO_RTR};
+use crate::pdo::PdoCobId;
 
 /// Whether a step writes a value or reads it back to verify it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -121,7 +121,7 @@ impl Step {
             return false;
         };
         let mask = if self.kind == StepKind::CobId {
-            !u64::from(COB_ID_NO_RTR)
+            !u64::from(PdoCobId(0).with_rtr_allowed(false).to_raw())
         } else {
             u64::MAX
         };
@@ -201,7 +201,7 @@ impl fmt::Display for Step {
                 match self.kind {
                     StepKind::CobIdDisabled => f.write_str(", disabling the PDO")?,
                     StepKind::MappingCleared => f.write_str(", switching the mapping off")?,
-                    StepKind::CobId if self.value & COB_ID_INVALID != 0 => {
+                    StepKind::CobId if !PdoCobId(self.value).is_valid() => {
                         f.write_str(", leaving the PDO disabled")?
                     }
                     StepKind::CobId => f.write_str(", enabling the PDO")?,

@@ -1,5 +1,6 @@
 use super::*;
 use crate::od::{NodeId, PdoLengthError};
+use std::collections::BTreeMap;
 
 /// (action, index, sub, bytes) of every step.
 fn plan(config: &PdoConfig<'_>) -> Vec<(StepAction, u16, u8, Vec<u8>)> {
@@ -14,11 +15,11 @@ const STATUS_AND_POSITION: [u32; 2] = [0x6041_0010, 0x6064_0020];
 /// TPDO1 of node 5: status word and position actual value, event-driven,
 /// inhibit 10 ms, event timer 500 ms.
 fn tpdo1() -> PdoConfig<'static> {
-    PdoConfig::new(PdoDirection::Tpdo, 1, 0x185, &STATUS_AND_POSITION)
+    PdoConfig::new(PdoDirection::Tpdo, 1, PdoCobId(0x185), &STATUS_AND_POSITION)
         .unwrap()
-        .with_transmission_type(254)
-        .with_inhibit_time(100)
-        .with_event_timer(500)
+        .with_transmission_type(TransmissionType::from_raw(254))
+        .with_inhibit_time(InhibitTime(100))
+        .with_event_timer(EventTimer(500))
 }
 
 #[test]
@@ -57,7 +58,7 @@ fn two_entry_mapping_follows_the_cia_301_order() {
 fn only_given_parameters_are_written() {
     use StepAction::{ReadBack, Write};
     let entries = [0x6040_0010];
-    let config = PdoConfig::new(PdoDirection::Rpdo, 2, 0x305, &entries)
+    let config = PdoConfig::new(PdoDirection::Rpdo, 2, PdoCobId(0x305), &entries)
         .unwrap()
         .with_sync_start(0);
     assert_eq!(
@@ -78,14 +79,14 @@ fn only_given_parameters_are_written() {
     ];
     assert_eq!(plan(&config), expected);
     // An empty mapping: off, count 0, COB-ID.
-    let empty = PdoConfig::new(PdoDirection::Tpdo, 512, 0x8000_0000, &[]).unwrap();
+    let empty = PdoConfig::new(PdoDirection::Tpdo, 512, PdoCobId(0x8000_0000), &[]).unwrap();
     assert_eq!(
         (empty.communication_index, empty.mapping_index),
         (0x19FF, 0x1BFF)
     );
     assert_eq!(plan(&empty).len(), 6);
-    assert!(PdoConfig::new(PdoDirection::Tpdo, 0, 0x185, &[]).is_none());
-    assert!(PdoConfig::new(PdoDirection::Tpdo, 513, 0x185, &[]).is_none());
+    assert!(PdoConfig::new(PdoDirection::Tpdo, 0, PdoCobId(0x185), &[]).is_none());
+    assert!(PdoConfig::new(PdoDirection::Tpdo, 513, PdoCobId(0x185), &[]).is_none());
 }
 
 #[test]
@@ -149,10 +150,10 @@ fn check_refuses_what_cia_301_rules_out() {
     let cases = [
         (
             PdoConfig {
-                cob_id: 0x2000_0185,
+                cob_id: PdoCobId(0x0000_0985),
                 ..base
             },
-            ConfigCheckError::CobId(CobIdError::Extended(0x2000_0185)),
+            ConfigCheckError::CobId(CobIdError::OutOfRange(PdoCobId(0x985))),
         ),
         (
             PdoConfig {
@@ -199,10 +200,10 @@ fn check_refuses_what_cia_301_rules_out() {
             ConfigCheckError::TooManyEntries(65),
         ),
         (
-            base.with_transmission_type(241),
+            base.with_transmission_type(TransmissionType::from_raw(241)),
             ConfigCheckError::TransmissionType {
                 direction: PdoDirection::Tpdo,
-                value: 241,
+                value: TransmissionType::from_raw(241),
             },
         ),
         (base.with_sync_start(241), ConfigCheckError::SyncStart(241)),
@@ -211,13 +212,19 @@ fn check_refuses_what_cia_301_rules_out() {
         assert_eq!(config.check(), Err(error));
     }
     // RTR-only types exist for TPDOs, not for RPDOs.
-    assert_eq!(base.with_transmission_type(252).check(), Ok(()));
-    let rpdo = PdoConfig::new(PdoDirection::Rpdo, 1, 0x205, &STATUS_AND_POSITION).unwrap();
     assert_eq!(
-        rpdo.with_transmission_type(253).check(),
+        base.with_transmission_type(TransmissionType::from_raw(252))
+            .check(),
+        Ok(())
+    );
+    let rpdo =
+        PdoConfig::new(PdoDirection::Rpdo, 1, PdoCobId(0x205), &STATUS_AND_POSITION).unwrap();
+    assert_eq!(
+        rpdo.with_transmission_type(TransmissionType::from_raw(253))
+            .check(),
         Err(ConfigCheckError::TransmissionType {
             direction: PdoDirection::Rpdo,
-            value: 253
+            value: TransmissionType::from_raw(253)
         })
     );
     // 64 one-bit entries fill the PDO exactly.
@@ -254,8 +261,8 @@ impl od::Pdo for Gapped {
     const MAPPING_INDEX: u16 = 0x1A02;
     const LEN: usize = 4;
     const MAPPING: &'static [u32] = &[0x6041_0010, 0x0006_0010];
-    fn default_cob_id(node: NodeId) -> Option<u32> {
-        Some(0x4000_0380 + u32::from(node.get()))
+    fn default_cob_id(node: NodeId) -> Option<PdoCobId> {
+        Some(PdoCobId(0x4000_0380 + u32::from(node.get())))
     }
     fn decode(_: &[u8]) -> Result<Self, PdoLengthError> {
         Ok(Gapped)
@@ -269,7 +276,7 @@ impl od::Pdo for Gapped {
 fn from_a_generated_pdo() {
     let node = NodeId::new(0x10).unwrap();
     let config = PdoConfig::from_pdo::<Gapped>(node).unwrap();
-    assert_eq!(config.cob_id, 0x4000_0390);
+    assert_eq!(config.cob_id, PdoCobId(0x4000_0390));
     assert_eq!(config.check(), Ok(()));
     let writes: Vec<(u16, u8, Vec<u8>)> = config
         .steps()
@@ -286,5 +293,106 @@ fn from_a_generated_pdo() {
             (0x1A02, 0, vec![0x02]),
             (0x1802, 1, vec![0x90, 0x03, 0x00, 0x40]),
         ]
+    );
+}
+
+/// Runs `session` against a device that keeps what is written, except the
+/// values `forget` names (read back as 0); returns the result and the
+/// actions in order.
+fn run_session(
+    session: &mut ConfigSession<'_>,
+    forget: &[(u16, u8)],
+) -> (Result<(), ReadBackMismatch>, Vec<ConfigAction>) {
+    let mut objects: BTreeMap<(u16, u8), Vec<u8>> = BTreeMap::new();
+    let mut actions = Vec::new();
+    loop {
+        let action = session.poll_action();
+        actions.push(action);
+        match action {
+            ConfigAction::Write(step) => {
+                let kept = if forget.contains(&(step.index(), step.sub())) {
+                    vec![0; step.bytes().len()]
+                } else {
+                    step.bytes().to_vec()
+                };
+                objects.insert((step.index(), step.sub()), kept);
+                session.on_written();
+            }
+            ConfigAction::ReadBack(step) => {
+                let read = objects
+                    .get(&(step.index(), step.sub()))
+                    .cloned()
+                    .unwrap_or_default();
+                session.on_read(&read);
+            }
+            ConfigAction::Done(result) => return (result, actions),
+        }
+    }
+}
+
+#[test]
+fn session_runs_the_plan_in_order_without_io() {
+    let config = tpdo1();
+    let mut session = ConfigSession::new(&config).unwrap();
+    let (result, actions) = run_session(&mut session, &[]);
+    assert_eq!(result, Ok(()));
+    let expected: Vec<ConfigAction> = config
+        .steps()
+        .map(|step| match step.action() {
+            StepAction::Write => ConfigAction::Write(step),
+            StepAction::ReadBack => ConfigAction::ReadBack(step),
+        })
+        .chain([ConfigAction::Done(Ok(()))])
+        .collect();
+    assert_eq!(actions, expected);
+    // Done stays done.
+    assert_eq!(session.poll_action(), ConfigAction::Done(Ok(())));
+}
+
+#[test]
+fn session_reports_a_value_the_device_did_not_keep() {
+    let config = tpdo1();
+    let mut session = ConfigSession::new(&config).unwrap();
+    // The event timer (sub 5) reads back as 0.
+    let (result, _) = run_session(&mut session, &[(0x1800, 5)]);
+    let mismatch = result.unwrap_err();
+    assert_eq!(mismatch.step.kind(), StepKind::EventTimer);
+    assert_eq!(mismatch.step.action(), StepAction::ReadBack);
+    assert_eq!((mismatch.number, mismatch.total), (15, config.step_count()));
+    assert_eq!(mismatch.read(), [0, 0]);
+    assert_eq!(
+        mismatch.to_string(),
+        "PDO configuration step 15 of 16 failed: read back event timer of 0x1800 \
+         (object 0x1800 sub 5): wrote 500 ms, read 0 ms; the device did not keep the value"
+    );
+    assert_eq!(session.poll_action(), ConfigAction::Done(Err(mismatch)));
+}
+
+#[test]
+fn session_waits_for_the_answer_of_its_step() {
+    let config = tpdo1();
+    let mut session = ConfigSession::new(&config).unwrap();
+    let first = session.poll_action();
+    assert_eq!(session.poll_action(), first, "asked again: the same step");
+    assert_eq!(session.position(), (1, config.step_count()));
+    // A read answer while a write waits changes nothing.
+    session.on_read(&[1, 2, 3, 4]);
+    assert_eq!(session.position(), (1, config.step_count()));
+    session.on_written();
+    assert_eq!(session.position(), (2, config.step_count()));
+    // An answer nobody asked for is ignored too.
+    session.on_written();
+    assert_eq!(session.position(), (2, config.step_count()));
+}
+
+#[test]
+fn session_refuses_an_invalid_configuration() {
+    let config = PdoConfig {
+        entries: &[0x6064_0020, 0x6064_0020, 0x6041_0010],
+        ..tpdo1()
+    };
+    assert_eq!(
+        ConfigSession::new(&config).err(),
+        Some(ConfigCheckError::TooLong { bits: 80 })
     );
 }

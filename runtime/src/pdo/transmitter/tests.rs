@@ -26,8 +26,15 @@ fn frames(t: &mut PdoTransmitter) -> Vec<Frame> {
     core::iter::from_fn(|| t.poll_transmit()).collect()
 }
 
+fn cfg(cob_id: u32, transmission_type: u8) -> TransmitterConfig {
+    TransmitterConfig::new(
+        PdoCobId(cob_id),
+        TransmissionType::from_raw(transmission_type),
+    )
+}
+
 fn transmitter(cob_id: u32, transmission_type: u8) -> PdoTransmitter {
-    PdoTransmitter::new(TransmitterConfig::new(cob_id, transmission_type)).unwrap()
+    PdoTransmitter::new(cfg(cob_id, transmission_type)).unwrap()
 }
 
 /// Feeds `syncs` and returns, per SYNC, the frames it triggered.
@@ -105,7 +112,7 @@ fn acyclic_type_0_sends_once_at_the_sync_after_a_change() {
 
 #[test]
 fn sync_start_value_picks_the_first_counted_sync() {
-    let mut config = TransmitterConfig::new(0x220, 2);
+    let mut config = cfg(0x220, 2);
     config.sync_start = 3;
     let mut t = PdoTransmitter::new(config).unwrap();
     t.set_data(ms(0), &[9]).unwrap();
@@ -131,7 +138,7 @@ fn sync_start_value_picks_the_first_counted_sync() {
 
 #[test]
 fn other_frames_do_not_count_as_sync() {
-    let mut config = TransmitterConfig::new(0x220, 1);
+    let mut config = cfg(0x220, 1);
     config.sync_cob_id = 0x081;
     let mut t = PdoTransmitter::new(config).unwrap();
     t.set_data(ms(0), &[1]).unwrap();
@@ -164,8 +171,8 @@ fn event_driven_sends_at_once_and_ignores_sync() {
 
 #[test]
 fn inhibit_time_coalesces_events_to_the_latest_data() {
-    let mut config = TransmitterConfig::new(0x201, 254);
-    config.inhibit_time = 10; // 10 x 100 µs = 1 ms
+    let mut config = cfg(0x201, 254);
+    config.inhibit_time = InhibitTime(10); // 10 x 100 µs = 1 ms
     let mut t = PdoTransmitter::new(config).unwrap();
     t.set_data(us(0), &[0xA0]).unwrap();
     assert_eq!(frames(&mut t), [data(0x201, &[0xA0])]);
@@ -192,8 +199,8 @@ fn inhibit_time_coalesces_events_to_the_latest_data() {
 
 #[test]
 fn event_timer_resends_without_events() {
-    let mut config = TransmitterConfig::new(0x201, 254);
-    config.event_timer = 100;
+    let mut config = cfg(0x201, 254);
+    config.event_timer = EventTimer(100);
     let mut t = PdoTransmitter::new(config).unwrap();
     assert_eq!(t.poll_timeout(), None, "no data yet");
     t.set_data(ms(0), &[7]).unwrap();
@@ -218,9 +225,9 @@ fn event_timer_resends_without_events() {
 
 #[test]
 fn event_timer_within_the_inhibit_time_waits_for_its_end() {
-    let mut config = TransmitterConfig::new(0x201, 255);
-    config.event_timer = 1;
-    config.inhibit_time = 25; // 2.5 ms
+    let mut config = cfg(0x201, 255);
+    config.event_timer = EventTimer(1);
+    config.inhibit_time = InhibitTime(25); // 2.5 ms
     let mut t = PdoTransmitter::new(config).unwrap();
     t.set_data(us(0), &[1]).unwrap();
     assert_eq!(frames(&mut t), [data(0x201, &[1])]);
@@ -244,8 +251,8 @@ fn an_unpolled_frame_is_replaced_by_newer_data() {
 #[test]
 fn disabled_cob_id_sends_nothing() {
     for transmission_type in [0, 1, 255] {
-        let mut config = TransmitterConfig::new(0x8000_0201, transmission_type);
-        config.event_timer = 10;
+        let mut config = cfg(0x8000_0201, transmission_type);
+        config.event_timer = EventTimer(10);
         let mut t = PdoTransmitter::new(config).unwrap();
         assert!(!t.is_enabled());
         t.set_data(ms(0), &[1, 2]).unwrap();
@@ -261,56 +268,61 @@ fn disabled_cob_id_sends_nothing() {
 
 #[test]
 fn enabling_and_disabling_at_run_time() {
-    let mut config = TransmitterConfig::new(0x201, 254);
-    config.event_timer = 50;
+    let mut config = cfg(0x201, 254);
+    config.event_timer = EventTimer(50);
     let mut t = PdoTransmitter::new(config).unwrap();
     t.set_data(ms(0), &[1]).unwrap();
     // Disabling drops the unpolled frame and the timer.
-    t.set_cob_id(ms(1), 0x8000_0201).unwrap();
+    t.set_cob_id(ms(1), PdoCobId(0x8000_0201)).unwrap();
     assert!(frames(&mut t).is_empty());
     assert_eq!(t.poll_timeout(), None);
     t.set_data(ms(2), &[2]).unwrap();
     assert!(frames(&mut t).is_empty());
     // Enabling on another identifier starts the event timer.
-    t.set_cob_id(ms(10), 0x202).unwrap();
+    t.set_cob_id(ms(10), PdoCobId(0x202)).unwrap();
     assert_eq!(t.poll_timeout(), Some(ms(60)));
     t.handle_timeout(ms(60));
     assert_eq!(frames(&mut t), [data(0x202, &[2])]);
-    assert_eq!(t.config().cob_id, 0x202);
+    assert_eq!(t.config().cob_id, PdoCobId(0x202));
     assert_eq!(
-        t.set_cob_id(ms(61), 0x2000_0202),
-        Err(CobIdError::Extended(0x2000_0202))
+        t.set_cob_id(ms(61), PdoCobId(0x0000_0A02)),
+        Err(CobIdError::OutOfRange(PdoCobId(0xA02)))
     );
-    assert_eq!(t.cob_id().id, 0x202);
+    assert_eq!(t.can_id(), CanId::Standard(0x202));
 }
 
 #[test]
 fn invalid_configurations_are_refused() {
     let bad = |config| PdoTransmitter::new(config).err();
     assert_eq!(
-        bad(TransmitterConfig::new(0x2000_0201, 255)),
-        Some(TransmitterConfigError::CobId(CobIdError::Extended(
-            0x2000_0201
+        bad(cfg(0x0000_0801, 255)),
+        Some(TransmitterConfigError::CobId(CobIdError::OutOfRange(
+            PdoCobId(0x801)
         )))
-    );
-    assert_eq!(
-        bad(TransmitterConfig::new(0x0000_0801, 255)),
-        Some(TransmitterConfigError::CobId(CobIdError::OutOfRange(0x801)))
     );
     for t in 241..=253 {
         assert_eq!(
-            bad(TransmitterConfig::new(0x201, t)),
-            Some(TransmitterConfigError::TransmissionType(t))
+            bad(cfg(0x201, t)),
+            Some(TransmitterConfigError::TransmissionType(
+                TransmissionType::from_raw(t)
+            ))
         );
     }
-    let mut config = TransmitterConfig::new(0x201, 1);
+    // A 29-bit identifier goes out in an extended frame.
+    let mut t = transmitter(0x2000_0201, 255);
+    t.set_data(ms(0), &[7]).unwrap();
+    assert_eq!(
+        frames(&mut t),
+        [Frame::new(CanId::Extended(0x201), &[7]).unwrap()]
+    );
+    let mut config = cfg(0x201, 1);
     config.sync_start = 241;
     assert_eq!(bad(config), Some(TransmitterConfigError::SyncStart(241)));
-    let mut config = TransmitterConfig::new(0x201, 1);
+    let mut config = cfg(0x201, 1);
     config.sync_cob_id = 0x800;
     assert_eq!(bad(config), Some(TransmitterConfigError::SyncCobId(0x800)));
     // Bit 30 (no RTR) is fine.
-    assert!(PdoTransmitter::new(TransmitterConfig::new(0x4000_0201, 0)).is_ok());
+    assert!(PdoTransmitter::new(cfg(0x4000_0201, 0)).is_ok());
     let mut t = transmitter(0x201, 255);
     assert_eq!(t.set_data(ms(0), &[0; 9]), Err(FrameError::TooLong(9)));
     assert!(frames(&mut t).is_empty());
@@ -330,8 +342,8 @@ impl od::Pdo for Command {
     const MAPPING_INDEX: u16 = 0x1600;
     const LEN: usize = 6;
     const MAPPING: &'static [u32] = &[0x6040_0010, 0x607A_0020];
-    fn default_cob_id(node: NodeId) -> Option<u32> {
-        Some(0x200 + u32::from(node.get()))
+    fn default_cob_id(node: NodeId) -> Option<PdoCobId> {
+        Some(PdoCobId(0x200 + u32::from(node.get())))
     }
     fn decode(data: &[u8]) -> Result<Self, PdoLengthError> {
         match *data {
@@ -355,8 +367,9 @@ impl od::Pdo for Command {
 #[test]
 fn typed_data_from_a_generated_struct() {
     let node = NodeId::new(5).unwrap();
-    let config = TransmitterConfig::from_pdo::<Command>(node, 255).unwrap();
-    assert_eq!(config.cob_id, 0x205);
+    let config =
+        TransmitterConfig::from_pdo::<Command>(node, TransmissionType::EventDrivenProfile).unwrap();
+    assert_eq!(config.cob_id, PdoCobId(0x205));
     let mut t = PdoTransmitter::new(config).unwrap();
     t.set(
         ms(0),

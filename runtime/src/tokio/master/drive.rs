@@ -15,7 +15,6 @@ use std::collections::VecDeque;
 use std::vec::Vec;
 
 use super::Master;
-use crate::Instant;
 use crate::blocking::Error;
 use crate::cia402::session::{Action, OperationError, Read, Request, Session, SessionConfig};
 use crate::cia402::{Event, Move, State, Statusword, object};
@@ -23,6 +22,7 @@ use crate::master::MasterEvent;
 use crate::od::{NodeId, ObjectInfo};
 use crate::pdo::PdoEvent;
 use crate::tokio::Events;
+use crate::{CanId, Instant};
 
 pub use crate::blocking::DRIVE_EVENTS_KEPT;
 
@@ -115,8 +115,8 @@ impl Master {
                             ::tokio::select! {
                                 () = sleep => {}
                                 event = next_statusword_pdo(events, session) => {
-                                    if let Some((cob_id, data, len, at)) = event {
-                                        session.on_pdo(cob_id, data.get(..len).unwrap_or(&[]), at);
+                                    if let Some((can_id, data, len, at)) = event {
+                                        session.on_pdo(can_id, data.get(..len).unwrap_or(&[]), at);
                                     }
                                 }
                             }
@@ -133,15 +133,15 @@ impl Master {
 async fn next_statusword_pdo(
     events: &mut Events,
     session: &Session,
-) -> Option<(u16, [u8; 8], usize, Instant)> {
+) -> Option<(CanId, [u8; 8], usize, Instant)> {
     loop {
         match events.next().await? {
             MasterEvent::Pdo(PdoEvent::Received {
-                cob_id,
+                can_id,
                 data,
                 len,
                 at,
-            }) if session.is_statusword_pdo(cob_id) => return Some((cob_id, data, len, at)),
+            }) if session.is_statusword_pdo(can_id) => return Some((can_id, data, len, at)),
             _ => {}
         }
     }

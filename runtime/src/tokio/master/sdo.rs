@@ -10,8 +10,6 @@ use super::{Error, Master, SdoWaiter, Shared};
 use crate::Instant;
 use crate::blocking::{Object, RunError, Transfer, Upload, encode, give_up, visible_string};
 use crate::od::{self, Entry, NodeId};
-use crate::pdo::PdoConfig;
-use crate::pdo::blocking::{SdoAccess, run_steps};
 use crate::sdo::client::{self, Method};
 use crate::sdo::typed;
 
@@ -400,82 +398,5 @@ impl Master {
         let (buf, len) = encode::<E>(value, Object::new(Some(node), E::INDEX, sub))?;
         self.download(node, E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
             .await
-    }
-
-    /// Configures a PDO of `node` as [`crate::pdo::blocking::configure_pdo`]
-    /// does: the same check first (nothing is sent for an invalid
-    /// configuration), the writes in the CiA 301 order, the read-backs, and
-    /// the same errors (as [`Error::PdoConfig`]).
-    ///
-    /// The steps are those of the blocking implementation itself: it is
-    /// replayed over the answers of the transfers done so far, each run
-    /// telling the next transfer to do, until it ends.
-    pub async fn configure_pdo(&self, node: NodeId, config: &PdoConfig<'_>) -> Result<(), Error> {
-        let mut replay = Replay::default();
-        loop {
-            replay.at = 0;
-            let result = run_steps(&mut replay, config);
-            let Some(request) = replay.next.take() else {
-                return result.map_err(Error::from);
-            };
-            let answer = match request {
-                Request::Download { index, sub, data } => self
-                    .download(node, index, sub, &data)
-                    .await
-                    .map(|()| Vec::new()),
-                Request::Upload { index, sub } => self.upload(node, index, sub).await,
-            };
-            replay.answers.push(answer);
-        }
-    }
-}
-
-/// A transfer the PDO configuration asks for.
-enum Request {
-    Download { index: u16, sub: u8, data: Vec<u8> },
-    Upload { index: u16, sub: u8 },
-}
-
-/// The answers of the transfers done so far, for a replay of
-/// [`run_steps`]; the first transfer beyond them is recorded in `next`
-/// (and answered with a placeholder error that ends that run).
-#[derive(Default)]
-struct Replay {
-    answers: Vec<Result<Vec<u8>, Error>>,
-    at: usize,
-    next: Option<Request>,
-}
-
-impl Replay {
-    fn answer(&mut self, request: impl FnOnce() -> Request) -> Result<Vec<u8>, Error> {
-        let i = self.at;
-        self.at += 1;
-        match self.answers.get_mut(i) {
-            Some(Ok(data)) => Ok(data.clone()),
-            // A failed transfer ends the steps: it is the last answer and
-            // is replayed once, by the run that returns.
-            Some(failed) => core::mem::replace(failed, Err(Error::SdoBusy { node: None })),
-            None => {
-                if self.next.is_none() {
-                    self.next = Some(request());
-                }
-                Err(Error::SdoBusy { node: None })
-            }
-        }
-    }
-}
-
-impl SdoAccess for Replay {
-    fn download(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), Error> {
-        self.answer(|| Request::Download {
-            index,
-            sub,
-            data: data.to_vec(),
-        })
-        .map(drop)
-    }
-
-    fn upload(&mut self, index: u16, sub: u8) -> Result<Vec<u8>, Error> {
-        self.answer(|| Request::Upload { index, sub })
     }
 }

@@ -16,6 +16,7 @@ use std::sync::{Mutex, MutexGuard, PoisonError};
 
 use futures_core::Stream;
 
+use crate::CanId;
 use crate::master::MasterEvent;
 use crate::od::{self, PdoLengthError};
 use crate::pdo::PdoEvent;
@@ -192,7 +193,7 @@ impl Stream for Events {
 /// oldest are dropped and counted in [`Pdos::dropped`].
 #[derive(Debug)]
 pub struct Pdos<P> {
-    pub(super) cob_id: u16,
+    pub(super) can_id: CanId,
     pub(super) queue: std::sync::Arc<Queue<PdoEvent>>,
     pub(super) pdo: PhantomData<fn() -> P>,
 }
@@ -230,9 +231,9 @@ impl<P: od::Pdo> Pdos<P> {
         }
     }
 
-    /// The 11-bit identifier the stream receives.
-    pub fn cob_id(&self) -> u16 {
-        self.cob_id
+    /// The identifier the stream receives.
+    pub fn can_id(&self) -> CanId {
+        self.can_id
     }
 
     /// Number of queued frames.
