@@ -44,19 +44,17 @@ fn mark_token(token: &str, out: &mut String) {
         // A word may start at the token's start or where heck starts one
         // (after a lowercase letter or a digit); not inside an uppercase run.
         let at_start = i == 0 || !b[i - 1].is_ascii_uppercase();
-        if at_start && b[i].is_ascii_uppercase() {
-            if let Some(len) = word_at(&b[i..]) {
-                if i > 0 {
-                    out.push(' ');
-                }
-                out.push_str(&token[i..i + len].to_ascii_lowercase());
-                // A following lowercase word needs its own break.
-                if b.get(i + len).is_some_and(u8::is_ascii_lowercase) {
-                    out.push(' ');
-                }
-                i += len;
-                continue;
+        if let Some(len) = word_at(&b[i..]).filter(|_| at_start && b[i].is_ascii_uppercase()) {
+            if i > 0 {
+                out.push(' ');
             }
+            out.push_str(&token[i..i + len].to_ascii_lowercase());
+            // A following lowercase word needs its own break.
+            if b.get(i + len).is_some_and(u8::is_ascii_lowercase) {
+                out.push(' ');
+            }
+            i += len;
+            continue;
         }
         out.push(b[i] as char);
         i += 1;
