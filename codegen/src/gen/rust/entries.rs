@@ -125,6 +125,7 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
         items.extend(quote! {
             #doc
             pub mod #module {
+                use super::rt;
                 #[doc = " The object's index."]
                 pub const INDEX: u16 = #index;
                 #inner
