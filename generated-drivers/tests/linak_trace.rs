@@ -3,7 +3,7 @@
 //! manual states, and the commands encode to the frames it shows.
 
 use eds2rust_drivers::linak_techline::{self as linak, errors::LinakErrors, od, pdo};
-use eds2rust_runtime::od::{NodeId, PdoLengthError};
+use eds2rust_runtime::od::{NodeId, PdoLengthError, Scaled};
 
 fn node32() -> NodeId {
     NodeId::new(linak::DEFAULT_NODE_ID).expect("32 is a node id")

@@ -15,10 +15,12 @@ use core::fmt;
 
 mod array;
 mod info;
+mod scaled;
 pub mod standard;
 
 pub use array::{Array, Element, Elements, array_subindex};
 pub use info::{DefaultValue, Number, ObjectInfo};
+pub use scaled::{Scaled, ScaledRaw};
 
 /// A CiA 301 basic data type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
