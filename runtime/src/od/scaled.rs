@@ -88,7 +88,7 @@ fn round_steps(steps: f64, min: f64, max: f64) -> Option<i128> {
 #[inline]
 fn divisor(scale: f64) -> Option<f64> {
     let reciprocal = 1.0 / scale;
-    if !(scale.abs() < 1.0) || reciprocal.abs() >= 9.0e18 {
+    if scale.is_nan() || scale.abs() >= 1.0 || reciprocal.abs() >= 9.0e18 {
         return None;
     }
     let half = if reciprocal < 0.0 { -0.5 } else { 0.5 };
