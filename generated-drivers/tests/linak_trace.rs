@@ -4,7 +4,7 @@
 
 use eds2rust_drivers::linak_techline::{self as linak, errors::LinakErrors, od, pdo};
 use eds2rust_runtime::CanId;
-use eds2rust_runtime::od::{NodeId, PdoLengthError};
+use eds2rust_runtime::od::{NodeId, PdoLengthError, Scaled};
 use eds2rust_runtime::pdo::PdoCobId;
 
 fn node32() -> NodeId {

@@ -10,7 +10,7 @@ use std::thread;
 
 use eds2rust_drivers::linak_techline::{errors::LinakErrors, od};
 use eds2rust_runtime::blocking::{self, Error, SdoClient};
-use eds2rust_runtime::od::{AccessRight, Entry, NodeId};
+use eds2rust_runtime::od::{AccessRight, Entry, NodeId, Scaled};
 use eds2rust_runtime::sdo::client::ClientConfig;
 use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
 use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};

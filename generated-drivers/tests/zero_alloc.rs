@@ -13,7 +13,7 @@ use std::fmt::Write as _;
 use std::hint::black_box;
 
 use eds2rust_drivers::{interroll_ec5000bi as ir, linak_techline as lk, zimmer_acs as zm};
-use eds2rust_runtime::od::{Pdo, PdoLengthError};
+use eds2rust_runtime::od::{Pdo, PdoLengthError, Scaled};
 
 struct Counting;
 

@@ -15,10 +15,12 @@ use core::fmt;
 
 mod array;
 mod info;
+mod scaled;
 pub mod standard;
 
 pub use array::{Array, Element, Elements, array_subindex};
 pub use info::{DefaultValue, Number, ObjectInfo};
+pub use scaled::{Scaled, ScaledRaw};
 
 /// A CiA 301 basic data type.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -236,11 +238,13 @@ impl<E> TpdoAccess<E> for access::Const {}
 /// ARRAY are one generated type indexed by sub-index ([`Array`]).
 pub trait Entry {
     const INDEX: u16;
-    const SUBINDEX: u8;
+    /// The sub-index (0 for a VAR, which generated code leaves to this default).
+    const SUBINDEX: u8 = 0;
     /// The name in the source (EDS `ParameterName` or the YAML `name`).
     const NAME: &'static str;
     const DATA_TYPE: DataType;
-    const PDO_MAPPABLE: bool;
+    /// Whether the entry may be mapped into a PDO (generated code states only `true`).
+    const PDO_MAPPABLE: bool = false;
     /// The access right as a type: [`access::Ro`], [`access::Rw`], ...
     type Access: Access;
     /// The typed value: a primitive, or a generated enum, bit-field struct or

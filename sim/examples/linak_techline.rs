@@ -34,6 +34,7 @@ use eds2rust_runtime::emcy::EmcyEvent;
 use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState};
 use eds2rust_runtime::od::NodeId;
+use eds2rust_runtime::od::Scaled as _;
 use eds2rust_sim::harness::{Args, Harness, MasterPort};
 use eds2rust_sim::models::linak_techline::{LinakTechline, NODE, default_config, simulator_with};
 

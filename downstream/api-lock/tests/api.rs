@@ -5,6 +5,7 @@
 //! and fails on a mismatch.
 
 use api_lock::linak;
+use eds2rust_runtime::od::Scaled;
 
 #[test]
 fn the_generated_api_is_locked() {

@@ -8,7 +8,7 @@ use std::time::{Duration, Instant as WallClock};
 use eds2rust_runtime::blocking::{self, Master};
 use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::nmt::{NmtCommand, NmtEvent};
-use eds2rust_runtime::od::NodeId;
+use eds2rust_runtime::od::{NodeId, Scaled};
 use eds2rust_runtime::pdo::PdoEvent;
 use eds2rust_runtime::sdo::SdoError;
 use eds2rust_runtime::sdo::abort::AbortCode;

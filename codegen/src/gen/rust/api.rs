@@ -264,7 +264,12 @@ fn entry_lines(
             let number_ty = number.map_or_else(|| raw.tokens().to_string(), &path);
             lines.push(
                 k(),
-                &[&path(*kind), key, "enum", &values_text(table, &number_ty)],
+                &[
+                    &path(*kind),
+                    key,
+                    "enum",
+                    &values_text(table, *raw, &number_ty),
+                ],
             );
             if let (Some(number), Some((low, high))) = (number, table.numeric) {
                 lines.push(
@@ -316,7 +321,12 @@ fn entry_lines(
                     let number_ty = field_raw.tokens().to_string();
                     lines.push(
                         k(),
-                        &[&path(*id), key, "enum", &values_text(table, &number_ty)],
+                        &[
+                            &path(*id),
+                            key,
+                            "enum",
+                            &values_text(table, field_raw, &number_ty),
+                        ],
                     );
                 }
             }
@@ -347,8 +357,9 @@ fn unit_text(unit: Option<&str>, scale: Option<f64>, offset: Option<f64>) -> Str
     parts.join(" ")
 }
 
-/// A value table: `number(T) 0x0..=0xFAFF, 0xFB00 "Clear error", …, other "Invalid"`.
-fn values_text(table: &ValueTable, number_ty: &str) -> String {
+/// A value table: `number(T) 0x0..=0xFAFF, 0xFB00 "Clear error", …, other "Invalid"`
+/// (no `other` when the table covers every raw value of `raw`).
+fn values_text(table: &ValueTable, raw: super::prim::Prim, number_ty: &str) -> String {
     let mut parts = Vec::new();
     if let Some((low, high)) = table.numeric {
         parts.push(format!("number({number_ty}) {}..={}", num(low), num(high)));
@@ -361,7 +372,9 @@ fn values_text(table: &ValueTable, number_ty: &str) -> String {
         };
         parts.push(format!("{raw} {:?}", named.name));
     }
-    parts.push(format!("other {:?}", table.other));
+    if !super::enums::covers_all(table, raw) {
+        parts.push(format!("other {:?}", table.other));
+    }
     parts.join(", ")
 }
 

@@ -51,6 +51,12 @@ pub(super) fn items(
     let data_type = entries::data_type_tokens(rt, first.data_type);
     let access = entries::access_tokens(rt, first.access);
     let mappable = first.pdo_mappable;
+    // PDO_MAPPABLE false is the trait's default.
+    let mappable_const = mappable.then(|| {
+        quote!(
+            const PDO_MAPPABLE: bool = true;
+        )
+    });
     let doc =
         doc(cx, object, plan, &ident, &names_form).tokens_with_alias(name, &ident.to_string());
     let derives = super::derives::attr(super::derives::ENTRY, false);
@@ -63,7 +69,7 @@ pub(super) fn items(
             const SUBINDEX: u8 = #rt::od::array_subindex::<#ident>(SUB);
             const NAME: &'static str = #name;
             const DATA_TYPE: #rt::od::DataType = #data_type;
-            const PDO_MAPPABLE: bool = #mappable;
+            #mappable_const
             type Access = #access;
             type Value = #value_ty;
         }

@@ -125,6 +125,7 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
         items.extend(quote! {
             #doc
             pub mod #module {
+                use super::rt;
                 #[doc = " The object's index."]
                 pub const INDEX: u16 = #index;
                 #inner
@@ -200,16 +201,23 @@ fn entry_items(
     }
     let doc = doc.tokens_with_alias(source_name, &ident.to_string());
     let derives = super::derives::attr(super::derives::ENTRY, false);
+    // SUBINDEX 0 and PDO_MAPPABLE false are the trait's defaults.
+    let sub_const = (entry.subindex != 0).then(|| quote!(const SUBINDEX: u8 = #sub;));
+    let mappable_const = mappable.then(|| {
+        quote!(
+            const PDO_MAPPABLE: bool = true;
+        )
+    });
     out.extend(quote! {
         #doc
         #derives
         pub struct #ident;
         impl #rt::od::Entry for #ident {
             const INDEX: u16 = #index;
-            const SUBINDEX: u8 = #sub;
+            #sub_const
             const NAME: &'static str = #name;
             const DATA_TYPE: #rt::od::DataType = #data_type;
-            const PDO_MAPPABLE: bool = #mappable;
+            #mappable_const
             type Access = #access;
             type Value = #value_ty;
         }

@@ -77,22 +77,30 @@ pub(crate) fn value_enum(
             }),
         }
     }
-    let fallback = match variants.iter().position(|v| v.source == table.other) {
-        Some(i) => {
-            variants[i].carries = true;
-            i
-        }
-        None => {
-            variants.push(Variant {
-                name: ns.request(&table.other, "other", None),
-                source: table.other.clone(),
-                text: None,
-                members: Vec::new(),
-                carries: true,
-                pinned: false,
-            });
-            variants.len() - 1
-        }
+    // The fallback exists only when some raw value is left for it: a variant
+    // no raw value reads back as would not round-trip.
+    let fallback = if covers_all(table, raw) {
+        None
+    } else {
+        Some(
+            match variants.iter().position(|v| v.source == table.other) {
+                Some(i) => {
+                    variants[i].carries = true;
+                    i
+                }
+                None => {
+                    variants.push(Variant {
+                        name: ns.request(&table.other, "other", None),
+                        source: table.other.clone(),
+                        text: None,
+                        members: Vec::new(),
+                        carries: true,
+                        pinned: false,
+                    });
+                    variants.len() - 1
+                }
+            },
+        )
     };
     let names = ns.resolve(cx.diags);
     let units = variants
@@ -112,7 +120,6 @@ pub(crate) fn value_enum(
     let mut from_arms = Vec::new();
     let mut to_arms = Vec::new();
     let mut name_arms = Vec::new();
-    let mut covered: Vec<(i128, i128)> = Vec::new();
     if let Some((low, high)) = table.numeric {
         defs.push(quote! {
             #[doc = " A number (see the numeric range in the type's documentation)."]
@@ -131,7 +138,6 @@ pub(crate) fn value_enum(
             quote!(Self::Number(n) => n)
         });
         name_arms.push(quote!(Self::Number(_) => "number"));
-        covered.push((low, high));
     }
     for (i, v) in variants.iter().enumerate() {
         let ident = names.get(v.name);
@@ -151,7 +157,7 @@ pub(crate) fn value_enum(
         if !raws.is_empty() {
             head.push_str(&format!(" (raw {})", raws.join(", ")));
         }
-        if i == fallback {
+        if Some(i) == fallback {
             head.push_str(if raws.is_empty() {
                 ": every raw value not covered by another variant"
             } else {
@@ -180,7 +186,6 @@ pub(crate) fn value_enum(
             } else {
                 quote!(#pattern => Self::#ident)
             });
-            covered.push((low, high));
         }
         if v.carries {
             to_arms.push(quote!(Self::#ident(raw) => raw));
@@ -208,8 +213,8 @@ pub(crate) fn value_enum(
         })
         .chain(table.numeric.map(|_| quote!(Self::Number(_) => "number")))
         .collect();
-    let fallback_ident = names.get(variants[fallback].name);
-    if !covers(&mut covered, raw.range()) {
+    if let Some(fallback) = fallback {
+        let fallback_ident = names.get(variants[fallback].name);
         from_arms.push(quote!(_ => Self::#fallback_ident(raw)));
     }
     let has_float = number_scaled && raw.is_float();
@@ -359,6 +364,17 @@ pub(crate) fn raw_newtype(
             }
         }
     }
+}
+
+/// Whether the numeric range and the named values of `table` cover every
+/// raw value of `raw`, leaving nothing to the fallback (`other`).
+pub(crate) fn covers_all(table: &ValueTable, raw: Prim) -> bool {
+    let mut intervals: Vec<(i128, i128)> = table
+        .numeric
+        .into_iter()
+        .chain(table.named.iter().map(|n| (n.low, n.high)))
+        .collect();
+    covers(&mut intervals, raw.range())
 }
 
 /// Whether the inclusive intervals cover `range` completely.

@@ -22,6 +22,8 @@ use proc_macro2::{Ident, Span};
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
 use crate::ir::Origin;
 
+mod words;
+
 /// The case of a kind of identifier.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Case {
@@ -110,6 +112,7 @@ pub(crate) fn sanitize(text: &str, case: Case) -> String {
             _ => ascii.push(' '),
         }
     }
+    let ascii = words::mark_words(&ascii);
     let mut name = match case {
         Case::UpperCamel => ascii.to_upper_camel_case(),
         Case::Snake => ascii.to_snake_case(),

@@ -101,6 +101,8 @@ pub(crate) fn plan<'d>(
     types.reserve_canonical(canonical.reserved());
     let mut modules = Namespace::new("module `od`", Case::Snake);
     modules.reserve_canonical(canonical.reserved());
+    // The alias of the runtime crate in every generated module.
+    modules.reserve(super::RUNTIME_ALIAS);
     let mut root = Vec::new();
     let mut module_ids = Vec::new();
     for object in objects {

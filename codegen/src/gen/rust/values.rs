@@ -215,7 +215,7 @@ pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> T
             let mut doc = value_doc(entry, "The value");
             unit_doc(&mut doc, s);
             let name = names.get(*name);
-            let mut out = super::scaled::scaled(&name, *raw, s, None, &doc);
+            let mut out = super::scaled::scaled(cx.rt, &name, *raw, s, None, &doc);
             out.extend(scalar_impl(cx.rt, &name, *raw));
             out
         }
@@ -234,7 +234,14 @@ pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> T
                     let number = names.get(*number);
                     let mut doc = value_doc(entry, "The numeric part of the value");
                     unit_doc(&mut doc, s);
-                    out.extend(super::scaled::scaled(&number, *raw, s, table.numeric, &doc));
+                    out.extend(super::scaled::scaled(
+                        cx.rt,
+                        &number,
+                        *raw,
+                        s,
+                        table.numeric,
+                        &doc,
+                    ));
                     quote!(#number)
                 }
                 None => raw.tokens(),
@@ -339,7 +346,9 @@ fn unit_doc(doc: &mut Doc, s: &Semantics) {
     if !unit.is_empty() {
         line.push_str(&format!(", in {unit}"));
     }
-    doc.para(format!("{line}."));
+    doc.para(format!(
+        "{line} (`value()` and `from_value()` of the runtime's `od::Scaled`)."
+    ));
 }
 
 /// `from_raw`/`to_raw` of a newtype over the raw value (`Self(pub raw)`).

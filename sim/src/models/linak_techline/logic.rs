@@ -9,6 +9,7 @@ use eds2rust_drivers::linak_techline::od::{
     tpdo1_communication_parameter as tpdo1,
 };
 use eds2rust_runtime::nmt::NmtState;
+use eds2rust_runtime::od::Scaled as _;
 
 use super::diagnostics::{bump, raise_to, record_stop};
 use super::motion::{Arrival, Goal, Profile};
