@@ -294,7 +294,7 @@ impl Service for EmcyConsumer {
             return;
         }
         let Some(node) = frame
-            .cob_id()
+            .standard_id()
             .and_then(|id| id.checked_sub(0x080))
             .and_then(|n| u8::try_from(n).ok())
             .and_then(NodeId::new)

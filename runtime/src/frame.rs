@@ -148,8 +148,10 @@ impl Frame {
         self.id
     }
 
-    /// The 11-bit identifier, `None` for extended frames (CANopen ignores them).
-    pub const fn cob_id(&self) -> Option<u16> {
+    /// The 11-bit identifier as a number, `None` for extended frames
+    /// (CANopen's predefined connection set has only 11-bit identifiers).
+    /// The identifier itself, of either length, is [`Frame::id`].
+    pub const fn standard_id(&self) -> Option<u16> {
         match self.id {
             CanId::Standard(id) => Some(id),
             CanId::Extended(_) => None,

@@ -346,7 +346,7 @@ impl Service for GuardResponder {
     type Event = GuardResponderEvent;
 
     fn handle_frame(&mut self, now: Instant, frame: &Frame) {
-        if !frame.is_remote() || frame.cob_id() != Some(cob::heartbeat(self.node)) {
+        if !frame.is_remote() || frame.standard_id() != Some(cob::heartbeat(self.node)) {
             return;
         }
         self.reply_pending = true;

@@ -34,7 +34,7 @@ pub fn parse_error_control(frame: &Frame) -> Option<(NodeId, u8)> {
     if frame.is_remote() {
         return None;
     }
-    let id = frame.cob_id()?;
+    let id = frame.standard_id()?;
     let node = NodeId::new(u8::try_from(id.checked_sub(0x700)?).ok()?)?;
     match *frame.data() {
         [byte] => Some((node, byte)),
@@ -282,10 +282,12 @@ impl HeartbeatConsumer {
     }
 
     /// Monitors `node` with consumer time `time`, starting afresh (waiting
-    /// for its first heartbeat). A zero time stops monitoring it.
-    pub fn monitor(&mut self, node: NodeId, time: Duration) {
-        let entry = (!time.is_zero()).then_some(Monitor {
-            time,
+    /// for its first heartbeat); `None` stops monitoring it (as
+    /// [`HeartbeatConsumer::forget`]). A time shorter than the object's
+    /// unit, 1 ms, counts as 1 ms.
+    pub fn monitor(&mut self, node: NodeId, time: Option<Duration>) {
+        let entry = time.map(|time| Monitor {
+            time: time.max(Duration::from_millis(1)),
             deadline: None,
             state: None,
             timed_out: false,
@@ -307,7 +309,8 @@ impl HeartbeatConsumer {
     pub fn configure(&mut self, entries: &[u32]) {
         self.nodes = [None; 128];
         for (node, time) in entries.iter().filter_map(|e| parse_consumer_entry(*e)) {
-            self.monitor(node, time);
+            // A zero consumer time in the object is CiA 301's "not used".
+            self.monitor(node, (!time.is_zero()).then_some(time));
         }
     }
 
@@ -495,7 +498,7 @@ mod tests {
     #[test]
     fn consumer_times_out_once_after_exactly_the_consumer_time() {
         let mut c = HeartbeatConsumer::new();
-        c.monitor(node(32), Duration::from_millis(150));
+        c.monitor(node(32), Some(Duration::from_millis(150)));
         // Supervision starts with the first heartbeat.
         assert_eq!(c.poll_timeout(), None);
         c.handle_timeout(ms(10_000));
@@ -538,7 +541,7 @@ mod tests {
     #[test]
     fn consumer_reports_state_changes_and_every_boot_up() {
         let mut c = HeartbeatConsumer::new();
-        c.monitor(node(32), Duration::from_millis(150));
+        c.monitor(node(32), Some(Duration::from_millis(150)));
         let t = ms(0);
         for b in [0x00, 0x7F, 0x7F, 0x00, 0x00, 0x04] {
             c.handle_frame(t, &data(0x720, &[b]));
@@ -566,7 +569,7 @@ mod tests {
     fn producer_feeds_consumer() {
         let mut p = HeartbeatProducer::new(node(32), Some(Duration::from_millis(100)));
         let mut c = HeartbeatConsumer::new();
-        c.monitor(node(32), Duration::from_millis(150));
+        c.monitor(node(32), Some(Duration::from_millis(150)));
         p.start(ms(0));
         let mut seen = Vec::new();
         for t in (0..=1000).step_by(10) {

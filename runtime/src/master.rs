@@ -106,7 +106,7 @@ pub enum MasterEvent {
 /// The composite master: public cores plus one SDO client per server node.
 ///
 /// Configure the cores through their fields (for example
-/// `master.consumer.monitor(node, time)`,
+/// `master.consumer.monitor(node, Some(time))`,
 /// `master.pdo_rx.watch(..)`, `master.sync = Some(..)`), then call
 /// [`Master::start`] and run it as any [`Service`].
 #[derive(Debug)]

@@ -230,7 +230,7 @@ pub const fn command_frame(cmd: NmtCommand, target: NmtTarget) -> Frame {
 /// exactly 2 bytes, a known command and a node id of 0 (all nodes) or 1 to
 /// 127. Anything else gives `None`.
 pub fn parse_command(frame: &Frame) -> Option<(NmtCommand, NmtTarget)> {
-    if frame.cob_id() != Some(cob::NMT) || frame.is_remote() {
+    if frame.standard_id() != Some(cob::NMT) || frame.is_remote() {
         return None;
     }
     let [cmd, node] = *frame.data() else {

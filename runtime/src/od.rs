@@ -380,6 +380,7 @@ pub trait ErrorTable: Copy + fmt::Debug + fmt::Display {
 
 /// Why a value could not be encoded or decoded.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ValueError {
     /// The buffer holds `actual` bytes; the data type needs `expected`.
     Length { expected: usize, actual: usize },

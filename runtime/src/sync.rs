@@ -59,7 +59,7 @@ pub const fn sync_frame(cob_id: u16, counter: Option<u8>) -> Frame {
 /// `Some(Some(counter))` with one, `None` for other frames (other ids, remote
 /// frames, more than one data byte).
 pub fn parse_sync_on(cob_id: u16, frame: &Frame) -> Option<Option<u8>> {
-    if frame.is_remote() || frame.cob_id() != Some(cob_id) {
+    if frame.is_remote() || frame.standard_id() != Some(cob_id) {
         return None;
     }
     match *frame.data() {
@@ -284,7 +284,7 @@ impl Service for SyncConsumer {
     type Event = SyncEvent;
 
     fn handle_frame(&mut self, _now: Instant, frame: &Frame) {
-        if frame.is_remote() || frame.cob_id() != Some(self.cob_id) {
+        if frame.is_remote() || frame.standard_id() != Some(self.cob_id) {
             return;
         }
         match parse_sync_on(self.cob_id, frame) {

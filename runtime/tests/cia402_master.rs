@@ -351,7 +351,7 @@ fn statuswords_from_a_tpdo_without_polling() {
     let seen: Vec<Frame> = std::iter::from_fn(|| rig.monitor.try_recv()).collect();
     let uploads = seen
         .iter()
-        .filter(|f| f.cob_id() == Some(0x600 + u16::from(NODE)) && f.data()[0] == 0x40)
+        .filter(|f| f.standard_id() == Some(0x600 + u16::from(NODE)) && f.data()[0] == 0x40)
         .count();
     assert_eq!(uploads, 0);
     assert!(seen.iter().any(|f| f.id() == can_id));

@@ -47,7 +47,7 @@ fn rig() -> (Master<VirtualPort>, ManualClock, VirtualPort, VirtualBus) {
     let time = ManualClock::new();
     let mut core = master::Master::new(node(1), Some(PERIOD));
     core.consumer
-        .monitor(node(DEVICE), Duration::from_millis(100));
+        .monitor(node(DEVICE), Some(Duration::from_millis(100)));
     let mut m = Master::with_clock(bus.attach(), core, time.clock());
     m.start().unwrap();
     (m, time, peer, bus)
@@ -162,7 +162,7 @@ fn the_heartbeat_keeps_its_period_during_a_slow_sdo_read() {
     let sent = &m.bus().sent;
     assert_eq!(sent[0], (Instant::ZERO, frame(0x701, &[0x00])));
     assert_eq!(sent[1].0, Instant::ZERO);
-    assert_eq!(sent[1].1.cob_id(), Some(0x620));
+    assert_eq!(sent[1].1.standard_id(), Some(0x620));
     // Meanwhile every heartbeat went out exactly on time.
     let beats: Vec<Instant> = sent[2..]
         .iter()

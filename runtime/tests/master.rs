@@ -199,7 +199,7 @@ impl Rig {
 
         let mut core = master::Master::new(node(1), Some(PERIOD));
         core.consumer
-            .monitor(node(DEVICE), Duration::from_millis(200));
+            .monitor(node(DEVICE), Some(Duration::from_millis(200)));
         let mut master = Master::new(master_port, core);
         master.start().unwrap();
         Rig {
@@ -218,7 +218,7 @@ impl Rig {
         let frames = self.frames.lock().unwrap();
         frames
             .iter()
-            .filter(|(_, f)| f.cob_id() == Some(cob_id))
+            .filter(|(_, f)| f.standard_id() == Some(cob_id))
             .copied()
             .collect()
     }

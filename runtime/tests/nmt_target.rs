@@ -2,7 +2,6 @@
 //! through each public way of naming an NMT target, and the master sends
 //! what it built. Node 0 on the wire comes only from `NmtTarget::All`.
 
-
 use eds2rust_runtime::blocking::Master;
 use eds2rust_runtime::master;
 use eds2rust_runtime::nmt::{InvalidNodeId, NmtCommand, NmtTarget, command_frame};

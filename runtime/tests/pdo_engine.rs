@@ -434,7 +434,7 @@ impl Network {
     fn sent_on(&self, id: u16) -> Vec<(u64, Vec<u8>)> {
         self.log
             .iter()
-            .filter(|(_, f)| f.cob_id() == Some(id))
+            .filter(|(_, f)| f.standard_id() == Some(id))
             .map(|(t, f)| (t.as_micros() / 1000, f.data().to_vec()))
             .collect()
     }

@@ -66,7 +66,7 @@ struct FakeNode {
 impl FakeNode {
     /// The answer to one request, written out by hand from CiA 301.
     fn answer(&mut self, request: &Frame) -> Option<Frame> {
-        if request.cob_id() != Some(REQUEST) {
+        if request.standard_id() != Some(REQUEST) {
             return None;
         }
         let req = *request.data_padded();
@@ -262,7 +262,7 @@ mod tokio_drivers {
             };
             loop {
                 let request = port.recv().await.unwrap();
-                if request.cob_id() == Some(0x000) {
+                if request.standard_id() == Some(0x000) {
                     // The test's "stop" frame.
                     return node;
                 }

@@ -61,7 +61,7 @@ async fn typed_segmented_and_block_transfers() {
     let writes: Vec<Frame> = rig
         .seen()
         .into_iter()
-        .filter(|f| f.cob_id() == Some(0x620) && f.data().first() == Some(&0x2B))
+        .filter(|f| f.standard_id() == Some(0x620) && f.data().first() == Some(&0x2B))
         .collect();
     assert_eq!(writes[0].to_string(), "620#2B171000FA000000");
 }
@@ -148,7 +148,7 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
     let aborts: Vec<String> = rig
         .seen()
         .iter()
-        .filter(|f| f.cob_id() == Some(0x632))
+        .filter(|f| f.standard_id() == Some(0x632))
         .map(Frame::to_string)
         .collect();
     assert_eq!(aborts, ["632#4000100000000000", "632#8000100000000405"]);
@@ -175,7 +175,7 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
     let sent: Vec<String> = rig
         .seen()
         .iter()
-        .filter(|f| f.cob_id() == Some(0x632))
+        .filter(|f| f.standard_id() == Some(0x632))
         .map(Frame::to_string)
         .collect();
     assert_eq!(sent, ["632#4018100100000000", "632#8018100100000405"]);
@@ -202,7 +202,7 @@ async fn configure_pdo_writes_in_the_cia_301_order_and_reads_back() {
     let requests: Vec<(StepAction, u16, u8, Vec<u8>)> = rig
         .seen()
         .iter()
-        .filter(|f| f.cob_id() == Some(0x620))
+        .filter(|f| f.standard_id() == Some(0x620))
         .filter_map(|f| {
             let d = f.data();
             let index = u16::from_le_bytes([d[1], d[2]]);
@@ -243,7 +243,7 @@ async fn configure_pdo_writes_in_the_cia_301_order_and_reads_back() {
         e.to_string().starts_with("invalid PDO configuration"),
         "{e}"
     );
-    assert!(rig.seen().iter().all(|f| f.cob_id() != Some(0x620)));
+    assert!(rig.seen().iter().all(|f| f.standard_id() != Some(0x620)));
 
     // A device that refuses a write: the step and the abort are reported.
     let mut refused = config;

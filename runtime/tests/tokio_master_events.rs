@@ -24,7 +24,7 @@ use tokio::time::Instant as TokioInstant;
 async fn heartbeat_timeout_comes_at_the_right_virtual_time() {
     let mut rig = Rig::new(|core| {
         core.consumer
-            .monitor(node(DEVICE), Duration::from_millis(120));
+            .monitor(node(DEVICE), Some(Duration::from_millis(120)));
     })
     .await;
     let start = TokioInstant::now();
@@ -74,7 +74,7 @@ async fn emcy_and_nmt_events_and_command_frames() {
     let nmt: Vec<String> = rig
         .seen()
         .iter()
-        .filter(|f| f.cob_id() == Some(0x000))
+        .filter(|f| f.standard_id() == Some(0x000))
         .map(Frame::to_string)
         .collect();
     // CiA 301: start remote node 0x20, reset all nodes.
@@ -187,7 +187,7 @@ async fn lss_switch_and_inquire() {
     let lss: Vec<String> = rig
         .seen()
         .iter()
-        .filter(|f| f.cob_id() == Some(0x7E5))
+        .filter(|f| f.standard_id() == Some(0x7E5))
         .map(Frame::to_string)
         .collect();
     // CiA 305: switch state global (0x04) configuration, inquire vendor

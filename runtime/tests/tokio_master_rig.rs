@@ -136,7 +136,7 @@ impl Service for Device {
         self.lss.handle_frame(now, frame);
         while self.lss.poll_event().is_some() {}
         self.tpdo.handle_frame(now, frame);
-        if frame.cob_id() == Some(0x080) {
+        if frame.standard_id() == Some(0x080) {
             // The value of the next SYNC.
             self.counter = self.counter.wrapping_add(1);
             let _ = self.tpdo.set_data(now, &self.counter.to_le_bytes());
@@ -243,7 +243,7 @@ impl Rig {
 pub async fn recv_from(port: &mut VirtualPort, cob_id: u16) -> std::io::Result<Frame> {
     loop {
         let frame = AsyncBus::recv(port).await?;
-        if frame.cob_id() == Some(cob_id) {
+        if frame.standard_id() == Some(cob_id) {
             return Ok(frame);
         }
     }

@@ -30,7 +30,7 @@ fn data() -> Vec<u8> {
 fn requests(frames: &[Frame]) -> Vec<&Frame> {
     frames
         .iter()
-        .filter(|f| f.cob_id() == Some(0x620))
+        .filter(|f| f.standard_id() == Some(0x620))
         .collect()
 }
 

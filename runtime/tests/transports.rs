@@ -38,7 +38,7 @@ fn concurrent_senders_keep_one_order_for_all_receivers() {
     for t in 0..4u16 {
         let counts: Vec<u16> = seen1
             .iter()
-            .filter(|f| f.cob_id() == Some(0x100 + t))
+            .filter(|f| f.standard_id() == Some(0x100 + t))
             .map(|f| u16::from_le_bytes([f.data()[0], f.data()[1]]))
             .collect();
         assert_eq!(counts, (0..500).collect::<Vec<_>>());

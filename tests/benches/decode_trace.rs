@@ -288,7 +288,7 @@ fn main() {
     for f in pdo_only.iter().take(PDOS.len() * 64) {
         let k = PDOS
             .iter()
-            .position(|p| Some(p.4) == f.cob_id())
+            .position(|p| Some(p.4) == f.standard_id())
             .expect("a PDO of the table");
         per_pdo[k].push(f.data().to_vec());
         d.frame(0, None, f, &mut out);

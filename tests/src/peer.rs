@@ -214,7 +214,7 @@ impl PyPeer {
             let left = deadline.saturating_duration_since(Instant::now());
             match port.recv(left) {
                 Ok(Some(frame)) if frame == marker => return Ok(before),
-                Ok(Some(frame)) if frame.cob_id() == Some(MARKER_ID) => {}
+                Ok(Some(frame)) if frame.standard_id() == Some(MARKER_ID) => {}
                 Ok(Some(frame)) => before.push(frame),
                 Ok(None) => return Err(self.failure("the marker frame did not come back")),
                 Err(e) => return Err(e.to_string()),

@@ -388,8 +388,9 @@ impl Run<'_> {
 
     /// Waits until the recorder has seen `count` frames of `id` with `data`.
     fn on_bus(&self, what: &str, count: usize, id: u16, data: &[u8]) -> Result<(), String> {
-        self.tap
-            .wait(what, count, |f| f.cob_id() == Some(id) && f.data() == data)
+        self.tap.wait(what, count, |f| {
+            f.standard_id() == Some(id) && f.data() == data
+        })
     }
 
     fn script(&self) -> Result<Session, String> {
@@ -463,7 +464,7 @@ impl Run<'_> {
             self.ok(json!({"op": "emcy", "node": local, "code": sent.code,
                            "register": sent.register, "data": hex(&sent.data)}))?;
             self.tap.wait("the LocalNode's EMCY", count, |f| {
-                f.cob_id() == Some(0x80 + u16::from(local))
+                f.standard_id() == Some(0x80 + u16::from(local))
             })?;
         }
         // What python-canopen logged.

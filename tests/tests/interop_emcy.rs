@@ -62,7 +62,7 @@ fn python_emcy_decodes_in_our_consumer() {
     let (events, frames) =
         python_emcy(&mut port, &mut consumer, ID, 0x3211, 0x05, &[1, 2, 3, 4, 5]);
     assert_eq!(frames.len(), 1, "{frames:?}");
-    assert_eq!(frames[0].cob_id(), Some(0x080 + u16::from(ID)));
+    assert_eq!(frames[0].standard_id(), Some(0x080 + u16::from(ID)));
     // CiA 301 layout: code little endian, register, manufacturer bytes.
     assert_eq!(frames[0].data(), &[0x11, 0x32, 0x05, 1, 2, 3, 4, 5]);
     let expected = Emcy {

@@ -202,7 +202,7 @@ fn python_nmt_commands_parse_with_our_slave() {
         }
         frames
             .into_iter()
-            .filter(|f| f.cob_id() == Some(0))
+            .filter(|f| f.standard_id() == Some(0))
             .collect()
     };
     let events =
@@ -306,7 +306,7 @@ fn python_heartbeat_reaches_our_consumer() {
     let clock = Clock::new();
     let mut port = py.port();
     let mut consumer = HeartbeatConsumer::new();
-    consumer.monitor(n, Duration::from_millis(150));
+    consumer.monitor(n, Some(Duration::from_millis(150)));
 
     ok(
         py,
@@ -430,7 +430,7 @@ fn our_heartbeat_reaches_python() {
     assert_eq!(reply["heard"], json!([0, 127, 127]), "{reply}");
     assert_eq!(reply["state"], "PRE-OPERATIONAL");
     for frame in &bus.sent {
-        assert_eq!(frame.cob_id(), Some(0x700 + u16::from(ID)));
+        assert_eq!(frame.standard_id(), Some(0x700 + u16::from(ID)));
     }
 
     for (state, name, code) in [

@@ -41,7 +41,7 @@ fn frames(trace: &str) -> Vec<Frame> {
 fn command_bytes(frames: &[Frame], cob_id: u16) -> Vec<u8> {
     frames
         .iter()
-        .filter(|f| f.cob_id() == Some(cob_id))
+        .filter(|f| f.standard_id() == Some(cob_id))
         .filter_map(|f| f.data().first().copied())
         .collect()
 }
@@ -112,8 +112,8 @@ fn python_session_is_recorded() {
     let tpdo_ids: Vec<u16> = [0x180, 0x280, 0x380, 0x480].map(|b| b + node).to_vec();
     let on_bus: Vec<(u32, Vec<u8>)> = frames
         .iter()
-        .filter(|f| f.cob_id().is_some_and(|id| tpdo_ids.contains(&id)))
-        .map(|f| (u32::from(f.cob_id().unwrap_or(0)), f.data().to_vec()))
+        .filter(|f| f.standard_id().is_some_and(|id| tpdo_ids.contains(&id)))
+        .map(|f| (u32::from(f.standard_id().unwrap_or(0)), f.data().to_vec()))
         .collect();
     assert!(on_bus.len() >= 2, "{} PDO frames", on_bus.len());
     let decoded: Vec<(u32, Vec<u8>)> = s.pdos.iter().map(|p| (p.cob_id, p.data.clone())).collect();
@@ -126,7 +126,7 @@ fn python_session_is_recorded() {
     // EMCY and heartbeats agree with the trace.
     let emcy: Vec<&Frame> = frames
         .iter()
-        .filter(|f| f.cob_id() == Some(0x80 + local))
+        .filter(|f| f.standard_id() == Some(0x80 + local))
         .collect();
     assert_eq!(emcy.len(), s.emcy.len());
     assert!(!emcy.is_empty());
@@ -139,7 +139,7 @@ fn python_session_is_recorded() {
     let heartbeats: Vec<(u8, u8)> = frames
         .iter()
         .filter_map(|f| {
-            let id = f.cob_id()?;
+            let id = f.standard_id()?;
             let node = u8::try_from(id.checked_sub(0x700)?).ok()?;
             (1..=127).contains(&node).then(|| (node, f.data()[0]))
         })

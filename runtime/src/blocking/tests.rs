@@ -38,7 +38,7 @@ impl Pinger {
 impl Service for Pinger {
     type Event = PingEvent;
     fn handle_frame(&mut self, _now: Instant, frame: &Frame) {
-        if frame.cob_id() == Some(self.listen) {
+        if frame.standard_id() == Some(self.listen) {
             self.events.push(PingEvent::Got(*frame));
         }
     }
@@ -219,18 +219,12 @@ fn run_and_serve_take_deadlines_in_the_cores_time() {
     let mut core = Pinger::new(None, 0x200, Duration::from_millis(10));
     let mut ticks = 0;
     let deadline = clock.now() + Duration::from_millis(35);
-    let result = run(
-        &mut port,
-        &clock,
-        &mut core,
-        deadline,
-        |event| {
-            if let PingEvent::Tick(_) = event {
-                ticks += 1;
-            }
-            ControlFlow::<()>::Continue(())
-        },
-    );
+    let result = run(&mut port, &clock, &mut core, deadline, |event| {
+        if let PingEvent::Tick(_) = event {
+            ticks += 1;
+        }
+        ControlFlow::<()>::Continue(())
+    });
     assert!(matches!(result, Err(RunError::Deadline)));
     assert_eq!(clock.now(), deadline);
     assert_eq!(ticks, 3);

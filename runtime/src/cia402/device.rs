@@ -86,6 +86,7 @@ impl DeviceConfig {
 
 /// What happened in the device.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum DeviceEvent {
     /// Transition `number` (0..=16) from `from` (`None`: the start) to `to`.
     Transition {

@@ -185,7 +185,8 @@ const fn with_u32(cs: u8, value: u32) -> [u8; 8] {
 
 /// Whether `frame` is a data frame on `cob_id` with exactly 8 bytes.
 fn lss_data(frame: &Frame, cob_id: u16) -> Option<&[u8]> {
-    (frame.cob_id() == Some(cob_id) && !frame.is_remote() && frame.len() == 8).then(|| frame.data())
+    (frame.standard_id() == Some(cob_id) && !frame.is_remote() && frame.len() == 8)
+        .then(|| frame.data())
 }
 
 impl Request {

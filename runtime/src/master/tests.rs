@@ -136,7 +136,8 @@ fn the_deadline_is_the_earliest_of_all_cores_and_only_due_cores_run() {
 #[test]
 fn every_core_sees_every_frame() {
     let mut m = Master::new(node(1), None);
-    m.consumer.monitor(node(5), Duration::from_millis(500));
+    m.consumer
+        .monitor(node(5), Some(Duration::from_millis(500)));
     m.pdo_rx.watch(PdoCobId(0x185), 2, None).unwrap();
     m.add_sdo_client(node(5), ClientConfig::new(Channel::default_for(node(5))));
     m.start(ms(0));

@@ -144,6 +144,7 @@ impl fmt::Debug for PdoCobId {
 
 /// A PDO COB-ID entry that names no identifier.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum CobIdError {
     /// Bit 29 is clear (an 11-bit identifier) but bits 11 to 28 are not
     /// all zero.

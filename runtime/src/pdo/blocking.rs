@@ -12,6 +12,7 @@ use crate::transport::Bus;
 
 /// Why [`configure_pdo`] failed.
 #[derive(Debug)]
+#[non_exhaustive]
 pub enum PdoConfigError {
     /// The configuration breaks a CiA 301 rule; nothing was sent.
     Invalid(ConfigCheckError),

@@ -36,6 +36,7 @@ pub const MAX_ENTRIES: usize = 64;
 
 /// The parameters of one PDO to configure on a device.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct PdoConfig<'a> {
     /// RPDO (received by the device) or TPDO (sent by it).
     pub direction: PdoDirection,
@@ -288,6 +289,7 @@ impl<'a> PdoConfig<'a> {
 
 /// What CiA 301 rules out in a [`PdoConfig`] (see [`PdoConfig::check`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum ConfigCheckError {
     /// The COB-ID entry names no identifier.
     CobId(CobIdError),

@@ -16,6 +16,7 @@ pub const RECEIVER_EVENTS: usize = 16;
 
 /// What a [`PdoReceiver`] saw.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum PdoEvent {
     /// A watched PDO arrived with its expected length.
     Received {
@@ -79,6 +80,7 @@ impl PdoEvent {
 
 /// Why [`PdoReceiver::watch`] refused a PDO.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum WatchError {
     /// Every slot is taken.
     Full,

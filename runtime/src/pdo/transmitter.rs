@@ -14,6 +14,7 @@ use crate::{CanId, Frame, Instant, Service, od};
 /// CiA 301 communication parameter object (0x1400.. on the receiving
 /// device).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub struct TransmitterConfig {
     /// The COB-ID entry: bit 31 set disables the PDO, bit 30 (no RTR) is
     /// ignored.
@@ -62,6 +63,7 @@ impl TransmitterConfig {
 
 /// A transmitter configuration this engine cannot run.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[non_exhaustive]
 pub enum TransmitterConfigError {
     /// The COB-ID entry names no identifier.
     CobId(CobIdError),

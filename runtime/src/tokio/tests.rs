@@ -15,7 +15,7 @@ struct Ticker {
 impl Service for Ticker {
     type Event = Result<Frame, Instant>;
     fn handle_frame(&mut self, _now: Instant, frame: &Frame) {
-        if frame.cob_id() == Some(0x200) {
+        if frame.standard_id() == Some(0x200) {
             self.events.push(Ok(*frame));
         }
     }

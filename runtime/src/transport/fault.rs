@@ -114,7 +114,7 @@ pub struct FaultInjector {
 
 /// Whether a frame is on an SDO identifier (0x581..=0x67F).
 fn is_sdo(frame: &Frame) -> bool {
-    matches!(frame.cob_id(), Some(0x581..=0x67F)) && frame.len() == 8 && !frame.is_remote()
+    matches!(frame.standard_id(), Some(0x581..=0x67F)) && frame.len() == 8 && !frame.is_remote()
 }
 
 impl FaultInjector {
@@ -189,7 +189,7 @@ impl FaultInjector {
                 d[2] ^= flip[1];
             }
         }
-        let id = frame.cob_id().unwrap_or(0);
+        let id = frame.standard_id().unwrap_or(0);
         Frame::standard(id, d, 8)
     }
 

@@ -116,7 +116,8 @@ impl Sim {
                         .push((self.target_position, relative, immediate));
                 }
                 DeviceEvent::HomingStarted => self.homing_until = Some(now + SETTLE),
-                DeviceEvent::Transition { .. } => {}
+                // Transitions and events of later versions need no motion.
+                _ => {}
             }
         }
         let ms = now.saturating_duration_since(self.last).as_millis() as u64;

@@ -142,7 +142,7 @@ fn channel() -> Channel {
 fn to_channel(frames: Vec<(Duration, Frame)>, cob: CanId) -> Vec<(Duration, Frame)> {
     frames
         .into_iter()
-        .map(|(step, f)| match f.cob_id() {
+        .map(|(step, f)| match f.standard_id() {
             Some(id) if !(0x580..=0x67F).contains(&id) && !f.is_remote() => {
                 let mut data = [0u8; 8];
                 data[..f.len()].copy_from_slice(f.data());
@@ -227,7 +227,7 @@ pub fn nmt_and_error_control(data: &[u8]) {
     feed(&mut NmtMaster::new(), &input, |_, _| {});
     let mut consumer = HeartbeatConsumer::new();
     for node in 1..=8 {
-        consumer.monitor(NodeId::new(node).unwrap(), Duration::from_millis(100));
+        consumer.monitor(NodeId::new(node).unwrap(), Some(Duration::from_millis(100)));
     }
     feed(&mut consumer, &input, |_, _| {});
     let mut guard = NodeGuard::new();

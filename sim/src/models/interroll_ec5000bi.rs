@@ -380,6 +380,7 @@ impl Ec5000Bi {
                     self.new_set_point(ctx, immediate, relative);
                 }
                 cia402::DeviceEvent::HomingStarted => self.home(ctx),
+                _ => {}
             }
         }
     }

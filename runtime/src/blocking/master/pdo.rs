@@ -16,11 +16,7 @@ use crate::transport::Bus;
 impl<B: Bus> Master<B> {
     /// Configures a PDO of `node` as [`crate::pdo::blocking::configure_pdo`]
     /// does (same steps, read-backs and errors).
-    pub fn configure_pdo(
-        &mut self,
-        node: NodeId,
-        config: &PdoConfig<'_>,
-    ) -> Result<(), Error> {
+    pub fn configure_pdo(&mut self, node: NodeId, config: &PdoConfig<'_>) -> Result<(), Error> {
         run_steps(&mut NodeSdo { master: self, node }, config).map_err(Error::from)
     }
 

@@ -15,11 +15,7 @@ impl Master {
     /// does: the same [`ConfigSession`] (nothing is sent for an invalid
     /// configuration, the writes in the CiA 301 order, the read-backs), and
     /// the same errors.
-    pub async fn configure_pdo(
-        &self,
-        node: NodeId,
-        config: &PdoConfig<'_>,
-    ) -> Result<(), Error> {
+    pub async fn configure_pdo(&self, node: NodeId, config: &PdoConfig<'_>) -> Result<(), Error> {
         let mut session = ConfigSession::new(config).map_err(PdoConfigError::from)?;
         loop {
             match session.poll_action() {
@@ -66,11 +62,7 @@ impl Master {
 
     /// The next `P` that `node` sends on its default COB-ID after this
     /// call, waiting at most `timeout` (see [`Master::next_pdo_on`]).
-    pub async fn next_pdo<P: od::Pdo>(
-        &self,
-        node: NodeId,
-        timeout: Duration,
-    ) -> Result<P, Error> {
+    pub async fn next_pdo<P: od::Pdo>(&self, node: NodeId, timeout: Duration) -> Result<P, Error> {
         let cob_id = pdo::default_cob_id::<P>(node)?;
         self.next_pdo_on(cob_id, timeout).await
     }

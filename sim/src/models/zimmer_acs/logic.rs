@@ -193,17 +193,16 @@ impl ZimmerAcs {
                 });
                 self.on_transition(ctx, number, to);
             }
+            // Taken at the next step, when an RPDO has written the target
+            // mapped after the controlword too.
             DeviceEvent::NewSetPoint {
                 immediate,
                 relative,
-            } => {
-                // Taken at the next step, when an RPDO has written the
-                // target mapped after the controlword too.
-                if self.mode() == ModeOfOperation::ProfilePosition {
-                    self.pending = Some((immediate, relative));
-                }
+            } if self.mode() == ModeOfOperation::ProfilePosition => {
+                self.pending = Some((immediate, relative));
             }
             DeviceEvent::HomingStarted => {}
+            _ => {}
         }
     }
 
