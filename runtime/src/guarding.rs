@@ -8,6 +8,7 @@
 //! life time (guard time × life time factor); the node reports a master
 //! whose requests stop for its life time (life guarding).
 
+use core::num::NonZeroU8;
 use core::time::Duration;
 
 use crate::frame::{CanId, cob};
@@ -24,6 +25,21 @@ pub fn guard_request(node: NodeId) -> Frame {
         [0; 8],
         0,
     ))
+}
+
+/// The life time of node guarding from the values of objects 0x100C
+/// (guard time) and 0x100D (life time factor): their product, or `None`
+/// when either is zero, which CiA 301 defines as "guarding not used".
+pub const fn life_time(guard_time: Duration, life_time_factor: u8) -> Option<Duration> {
+    if guard_time.is_zero() || life_time_factor == 0 {
+        return None;
+    }
+    // A guard time in ms times a u8 factor stays far from overflow; a
+    // Duration built otherwise saturates.
+    match guard_time.checked_mul(life_time_factor as u32) {
+        Some(life_time) => Some(life_time),
+        None => Some(Duration::MAX),
+    }
 }
 
 /// The guarding reply of `node`: 0x700 + node, data `[toggle << 7 | state]`.
@@ -113,18 +129,22 @@ impl NodeGuard {
         }
     }
 
-    /// Starts guarding `node` (afresh if it was guarded): the first request
-    /// is due at `now`, the life time runs from `now`. A zero guard time or
-    /// factor stops guarding the node (CiA 301: guarding disabled).
+    /// Starts guarding `node` (afresh if it was guarded): a request every
+    /// `guard_time` (at least 1 ms, the unit of object 0x100C), the first
+    /// due at `now`; the node is lost when no answer comes for
+    /// `guard_time × life_time_factor` from `now`. [`NodeGuard::forget`]
+    /// stops guarding it; for the object values, where a zero means
+    /// "guarding not used", see [`life_time`].
     pub fn guard(
         &mut self,
         now: Instant,
         node: NodeId,
         guard_time: Duration,
-        life_time_factor: u8,
+        life_time_factor: NonZeroU8,
     ) {
-        let life_time = guard_time.saturating_mul(u32::from(life_time_factor));
-        let entry = (!life_time.is_zero()).then_some(Guarded {
+        let guard_time = guard_time.max(Duration::from_millis(1));
+        let life_time = guard_time.saturating_mul(u32::from(life_time_factor.get()));
+        let entry = Some(Guarded {
             guard_time,
             life_time,
             next_request: now,
@@ -275,7 +295,7 @@ pub struct GuardResponder {
     state: NmtState,
     toggle: bool,
     reply_pending: bool,
-    life_time: Duration,
+    life_time: Option<Duration>,
     life_deadline: Option<Instant>,
     lost: bool,
     events: Ring<GuardResponderEvent, 4>,
@@ -290,7 +310,7 @@ impl GuardResponder {
             state: NmtState::PreOperational,
             toggle: false,
             reply_pending: false,
-            life_time: Duration::ZERO,
+            life_time: None,
             life_deadline: None,
             lost: false,
             events: Ring::new(),
@@ -323,10 +343,10 @@ impl GuardResponder {
     }
 
     /// Sets the life time (objects 0x100C guard time × 0x100D life time
-    /// factor); zero disables life guarding. Supervision (re)starts with the
-    /// next request.
-    pub fn set_life_time(&mut self, guard_time: Duration, life_time_factor: u8) {
-        self.life_time = guard_time.saturating_mul(u32::from(life_time_factor));
+    /// factor, see [`life_time`]); `None` switches life guarding off.
+    /// Supervision (re)starts with the next request.
+    pub fn set_life_time(&mut self, life_time: Option<Duration>) {
+        self.life_time = life_time;
         self.life_deadline = None;
         self.lost = false;
     }
@@ -350,8 +370,8 @@ impl Service for GuardResponder {
             return;
         }
         self.reply_pending = true;
-        if !self.life_time.is_zero() {
-            self.life_deadline = Some(now + self.life_time);
+        if let Some(life_time) = self.life_time {
+            self.life_deadline = Some(now + life_time);
             if self.lost {
                 self.lost = false;
                 self.events.push(GuardResponderEvent::LifeGuardingResumed);
@@ -394,6 +414,10 @@ mod tests {
         NodeId::new(n).unwrap()
     }
 
+    fn factor(n: u8) -> NonZeroU8 {
+        NonZeroU8::new(n).unwrap()
+    }
+
     fn data(id: u16, bytes: &[u8]) -> Frame {
         Frame::new(CanId::Standard(id), bytes).unwrap()
     }
@@ -430,8 +454,8 @@ mod tests {
     #[test]
     fn master_requests_every_guard_time() {
         let mut g = NodeGuard::new();
-        g.guard(ms(0), node(32), Duration::from_millis(100), 3);
-        g.guard(ms(0), node(5), Duration::from_millis(100), 3);
+        g.guard(ms(0), node(32), Duration::from_millis(100), factor(3));
+        g.guard(ms(0), node(5), Duration::from_millis(100), factor(3));
         assert_eq!(g.poll_timeout(), Some(ms(0)));
         g.handle_timeout(ms(0));
         assert_eq!(frames(&mut g), [rtr(0x705), rtr(0x720)]);
@@ -449,7 +473,7 @@ mod tests {
     #[test]
     fn master_checks_toggle_and_tracks_state() {
         let mut g = NodeGuard::new();
-        g.guard(ms(0), node(32), Duration::from_millis(100), 3);
+        g.guard(ms(0), node(32), Duration::from_millis(100), factor(3));
         g.handle_frame(ms(1), &data(0x720, &[0x7F]));
         assert_eq!(
             events(&mut g),
@@ -502,7 +526,7 @@ mod tests {
     #[test]
     fn master_life_time_expires_once() {
         let mut g = NodeGuard::new();
-        g.guard(ms(0), node(7), Duration::from_millis(100), 3);
+        g.guard(ms(0), node(7), Duration::from_millis(100), factor(3));
         for t in (0..=1000).step_by(50) {
             g.handle_timeout(ms(t));
             frames(&mut g);
@@ -531,18 +555,25 @@ mod tests {
         assert!(events(&mut g).is_empty());
         g.handle_timeout(ms(1310));
         assert_eq!(events(&mut g).len(), 1);
-        // Zero factor: guarding off.
-        g.guard(ms(0), node(7), Duration::from_millis(100), 0);
+        // Forgotten: guarding off.
+        g.forget(node(7));
         assert!(!g.is_guarded(node(7)));
         assert_eq!(g.poll_timeout(), None);
+        // The objects' zeros mean "not used".
+        assert_eq!(life_time(Duration::from_millis(100), 0), None);
+        assert_eq!(life_time(Duration::ZERO, 3), None);
+        assert_eq!(
+            life_time(Duration::from_millis(100), 3),
+            Some(Duration::from_millis(300))
+        );
     }
 
     #[test]
     fn master_and_responder_talk() {
         let mut g = NodeGuard::new();
         let mut r = GuardResponder::new(node(9));
-        r.set_life_time(Duration::from_millis(50), 4);
-        g.guard(ms(0), node(9), Duration::from_millis(50), 3);
+        r.set_life_time(life_time(Duration::from_millis(50), 4));
+        g.guard(ms(0), node(9), Duration::from_millis(50), factor(3));
         fn exchange(g: &mut NodeGuard, r: &mut GuardResponder, t: u64) {
             g.handle_timeout(ms(t));
             r.handle_timeout(ms(t));
@@ -607,7 +638,7 @@ mod tests {
     #[test]
     fn responder_detects_life_guarding_loss() {
         let mut r = GuardResponder::new(node(3));
-        r.set_life_time(Duration::from_millis(100), 2);
+        r.set_life_time(life_time(Duration::from_millis(100), 2));
         // Not before the first request.
         assert_eq!(r.poll_timeout(), None);
         r.handle_frame(ms(1000), &rtr(0x703));

@@ -235,7 +235,7 @@ pub fn nmt_and_error_control(data: &[u8]) {
         Instant::from_millis(1),
         NodeId::new(3).unwrap(),
         Duration::from_millis(50),
-        3,
+        core::num::NonZeroU8::new(3).unwrap(),
     );
     feed(&mut guard, &input, |_, _| {});
     feed(
