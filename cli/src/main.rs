@@ -402,7 +402,11 @@ fn check(files: &[PathBuf], options: &Options) -> ExitCode {
 }
 
 fn dump(path: &std::path::Path, node_id: Option<u8>, options: &Options) -> ExitCode {
-    let loaded = read_device(path, options);
+    let mut loaded = read_device(path, options);
+    if let (Some(n), Some(device)) = (node_id, &loaded.device) {
+        let errors = eds2rust::dump::json::node_id_diagnostics(device, n);
+        loaded.diagnostics.extend(errors);
+    }
     let name = path.display().to_string();
     let json =
         eds2rust::dump::json::to_json(&name, loaded.device.as_ref(), &loaded.diagnostics, node_id);

@@ -317,3 +317,36 @@ fn generate_prints_code_or_errors() {
 
     assert_eq!(run(&["generate"]).0, 2, "no input is a usage error");
 }
+
+/// `dump --node-id` never prints a `$NODEID` value its type cannot hold:
+/// the value is null and an error names the entry (exit code 1).
+#[test]
+fn dump_node_id_reports_values_out_of_range() {
+    let file = format!(
+        "{}/../codegen/tests/fixtures/malformed/nodeid_formula_overflow_u8.eds",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let (code, stdout, stderr) = run(&["dump", "--node-id", "5", &file]);
+    assert_eq!(code, 1, "{stderr}");
+    let doc: Value = serde_json::from_str(&stdout).unwrap();
+    let mode = entry(&doc, 0x2000, 0);
+    assert_eq!(mode["default"], Value::Null, "not 305");
+    assert_eq!(mode["low_limit"], 255, "$NODEID+250 fits node 5");
+    let errors: Vec<&str> = doc["diagnostics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|d| d["severity"] == "error")
+        .map(|d| d["message"].as_str().unwrap())
+        .collect();
+    assert_eq!(
+        errors,
+        [
+            "[0x2000 sub 0] DefaultValue: `$NODEID+300` gives 305 for node id 5, out of range for UNSIGNED8 (0..=255)"
+        ]
+    );
+    // Node 6 is past the ids `$NODEID+250` fits.
+    let (_, stdout, _) = run(&["dump", "--node-id", "6", &file]);
+    let doc: Value = serde_json::from_str(&stdout).unwrap();
+    assert_eq!(entry(&doc, 0x2000, 0)["low_limit"], Value::Null);
+}

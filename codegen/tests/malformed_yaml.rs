@@ -93,3 +93,22 @@ fn malformed_yaml_fixtures() {
         );
     }
 }
+
+/// A table beyond the YAML reader's node limit, generated here (too big to
+/// commit): one error in a sentence for people, not the reader's debug
+/// output, at the line where the reader stopped.
+#[test]
+fn yaml_too_many_nodes() {
+    let mut text = String::from("format: 1\nnotes:\n");
+    for _ in 0..260_000 {
+        text.push_str("  - x\n");
+    }
+    let file = "generated/yaml_too_many_nodes.yaml";
+    let loaded = read_bytes(file, text.as_bytes(), Path::new("."), &Options::default());
+    let d = &loaded.diagnostics;
+    assert_eq!(d.error_count(), 1, "{}", d.render());
+    let diag = d.iter().next().expect("one diagnostic");
+    assert!(diag.location.line.is_some(), "names a line");
+    assert!(!diag.message.contains("budget"), "{}", diag.message);
+    insta::assert_snapshot!("yaml_too_many_nodes", d.render());
+}

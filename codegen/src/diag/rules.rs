@@ -74,6 +74,10 @@ pub const RULES: &[Rule] = &[
         "eds::limits",
         "LowLimit/HighLimit that do not fit the type or each other",
     ),
+    rule(
+        "eds::line-endings",
+        "lines that end with CR alone (old Mac OS)",
+    ),
     rule("eds::missing-access", "an entry without AccessType"),
     rule("eds::missing-data-type", "an entry without DataType"),
     rule("eds::missing-name", "an object without ParameterName"),
@@ -88,7 +92,7 @@ pub const RULES: &[Rule] = &[
     ),
     rule(
         "eds::not-utf8",
-        "text that is not UTF-8, decoded as Windows-1252",
+        "text that is not UTF-8, decoded as UTF-16 (after a byte-order mark) or Windows-1252",
     ),
     rule(
         "eds::object-list",
@@ -160,7 +164,10 @@ pub const RULES: &[Rule] = &[
         "a `profiles:` value other than `none` or `builtin`",
     ),
     rule("table::bad-range", "a bit range that does not fit"),
-    rule("table::bad-scale", "a scale factor that cannot be used"),
+    rule(
+        "table::bad-scale",
+        "a scale factor or offset that cannot be used",
+    ),
     rule("table::bad-type", "a data type name that is not known"),
     rule(
         "table::bad-value",
@@ -203,6 +210,10 @@ pub const RULES: &[Rule] = &[
     ),
     rule("table::missing-key", "a key that is needed here"),
     rule("table::named-value", "a named value that cannot be used"),
+    rule(
+        "table::no-objects",
+        "an overlay that deletes every object of its base",
+    ),
     rule("table::node-id", "a node id outside 1..=127"),
     rule("table::not-utf8", "a table that is not UTF-8"),
     rule("table::overlap", "bit fields that overlap"),

@@ -4,8 +4,8 @@
 
 use serde_json::{Map, Value as Json, json};
 
-use crate::diag::Diagnostics;
-use crate::ir::{Device, Entry, Literal, Object, ObjectKind, Value};
+use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
+use crate::ir::{Device, Entry, Literal, Object, ObjectKind, Value, node_value_problems};
 
 /// Builds the JSON document. `node_id` resolves `$NODEID` formulas.
 pub fn to_json(
@@ -44,11 +44,48 @@ pub fn to_json(
     json!({"file": file, "device": device_json, "entries": entries, "diagnostics": diagnostics})
 }
 
+/// An error for every value of `device` that leaves its type once
+/// `$NODEID` is `node_id` (its JSON value is then null, never a number the
+/// node cannot hold).
+pub fn node_id_diagnostics(device: &Device, node_id: u8) -> Diagnostics {
+    let mut diags = Diagnostics::new();
+    for object in device.objects.values() {
+        for entry in object.entries.values() {
+            for (key, why) in node_value_problems(entry, node_id) {
+                let file = &entry.origin.file;
+                let is_table = file.ends_with(".yaml") || file.ends_with(".yml");
+                diags.push(Diagnostic {
+                    severity: Severity::Error,
+                    code: if is_table {
+                        "table::value-out-of-range"
+                    } else {
+                        "eds::value-out-of-range"
+                    },
+                    file: file.clone(),
+                    location: Location {
+                        line: (entry.origin.line > 0).then_some(entry.origin.line),
+                        section: Some(format!("0x{:04X} sub {}", object.index, entry.subindex)),
+                        key: Some(key.into()),
+                        ..Location::default()
+                    },
+                    message: why,
+                    notes: Vec::new(),
+                });
+            }
+        }
+    }
+    diags
+}
+
 fn entry_json(object: &Object, object_type: &str, entry: &Entry, node_id: Option<u8>) -> Json {
     let is_var = matches!(object.kind, ObjectKind::Var | ObjectKind::Domain);
     let value = |l: &Option<Literal>| {
-        l.as_ref()
-            .map_or(Json::Null, |l| value_json(&l.resolve(node_id)))
+        let value = match (l, node_id) {
+            (None, _) => return Json::Null,
+            (Some(l), Some(n)) => l.resolve_checked(n, entry.data_type),
+            (Some(l), None) => Ok(l.resolve(None)),
+        };
+        value.map_or(Json::Null, |v| value_json(&v))
     };
     let mut m = Map::new();
     m.insert("index".into(), object.index.into());

@@ -95,37 +95,88 @@ fn is_free_text_key(key: &str) -> bool {
         || key.get(..4).is_some_and(|p| p.eq_ignore_ascii_case("line"))
 }
 
-/// Decodes the bytes of a file: UTF-8, else Windows-1252 with a warning.
+/// Decodes the bytes of a file: UTF-8, else UTF-16 when a byte-order mark
+/// says so, else Windows-1252, with a warning saying what it was read as.
+/// CR line endings alone (old Mac OS) become line breaks, as in
+/// python-canopen's reader (Python's universal newlines), with a warning.
 pub fn decode(file: &str, bytes: &[u8], diags: &mut Diagnostics) -> String {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    match std::str::from_utf8(bytes) {
+    let text = match std::str::from_utf8(bytes) {
         Ok(text) => text.to_string(),
         Err(err) => {
-            let (text, _, _) = encoding_rs::WINDOWS_1252.decode(bytes);
+            // `decode` follows a UTF-16 byte-order mark, else reads Windows-1252.
+            let (text, encoding, _) = encoding_rs::WINDOWS_1252.decode(bytes);
             let text = text.into_owned();
-            let offset = err.valid_up_to();
-            let line = bytes[..offset].iter().filter(|&&b| b == b'\n').count() as u32 + 1;
-            // The span is in the decoded text: count decoded chars up to the same line.
-            let start = line_start(&text, line);
-            let end = text[start..].find('\n').map_or(text.len(), |n| start + n);
-            diags.push(Diagnostic {
-                severity: Severity::Warning,
-                code: "eds::not-utf8",
-                file: file.to_string(),
-                location: Location {
-                    line: Some(line),
-                    span: Some(start..end.max(start)),
-                    ..Location::default()
-                },
-                message: format!(
+            let (line, message) = if encoding == encoding_rs::WINDOWS_1252 {
+                let offset = err.valid_up_to();
+                let line = bytes[..offset].iter().filter(|&&b| b == b'\n').count() as u32 + 1;
+                let message = format!(
                     "the file is not valid UTF-8 (byte 0x{:02X} at line {line}); read as Windows-1252 (Latin-1)",
                     bytes[offset]
-                ),
-                notes: vec!["save the file as UTF-8 to silence this warning".into()],
-            });
+                );
+                (line, message)
+            } else {
+                let name = encoding.name();
+                let message = format!(
+                    "the file is {name}, not UTF-8 (it starts with a {name} byte-order mark); read as {name}"
+                );
+                (1, message)
+            };
+            let note = "save the file as UTF-8 to silence this warning";
+            warn_whole_line(file, &text, line, "eds::not-utf8", message, note, diags);
             text
         }
+    };
+    lone_cr_as_line_breaks(file, text, diags)
+}
+
+/// A file without LF whose lines end with CR alone (old Mac OS): every CR
+/// becomes LF, which keeps byte offsets and gives the line numbers an editor
+/// shows. A lone CR in a file of LF or CR LF lines stays as it is.
+fn lone_cr_as_line_breaks(file: &str, text: String, diags: &mut Diagnostics) -> String {
+    if text.contains('\n') || !text.contains('\r') {
+        return text;
     }
+    let text = text.replace('\r', "\n");
+    let message =
+        "the lines end with CR alone (old Mac OS line endings); each CR is read as a line break";
+    let note = "save the file with LF or CR LF line endings to silence this warning";
+    warn_whole_line(
+        file,
+        &text,
+        1,
+        "eds::line-endings",
+        message.into(),
+        note,
+        diags,
+    );
+    text
+}
+
+/// A warning about a whole line of the decoded text.
+fn warn_whole_line(
+    file: &str,
+    text: &str,
+    line: u32,
+    code: &'static str,
+    message: String,
+    note: &str,
+    diags: &mut Diagnostics,
+) {
+    let start = line_start(text, line);
+    let end = text[start..].find('\n').map_or(text.len(), |n| start + n);
+    diags.push(Diagnostic {
+        severity: Severity::Warning,
+        code,
+        file: file.to_string(),
+        location: Location {
+            line: Some(line),
+            span: Some(start..end.max(start)),
+            ..Location::default()
+        },
+        message,
+        notes: vec![note.to_string()],
+    });
 }
 
 fn line_start(text: &str, line: u32) -> usize {

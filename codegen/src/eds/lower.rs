@@ -144,6 +144,33 @@ impl<'a> Lowering<'a> {
         }
     }
 
+    /// `[DeviceComissioning] NodeID`: the configured node's id, 1..=127.
+    fn node_id(&mut self, section: Option<&Section>) -> Option<u8> {
+        let id: u8 = self.uint(section, "NodeID")?;
+        if crate::ir::NODE_IDS.contains(&id) {
+            return Some(id);
+        }
+        let (s, p) = (section?, section?.get("NodeID")?);
+        let mut notes =
+            vec!["write the id this DCF configures the node with, 1 to 127".to_string()];
+        if id == 255 {
+            notes.push(
+                "255 is how LSS (CiA 305) marks a node whose id is not configured yet; \
+                 a DCF describes one configured node"
+                    .into(),
+            );
+        }
+        self.report_with_notes(
+            Severity::Warning,
+            "eds::bad-number",
+            s,
+            Some(p),
+            format!("{id} is not a node id (1..=127); the key is ignored"),
+            notes,
+        );
+        None
+    }
+
     pub(super) fn flag(&mut self, section: Option<&Section>, key: &str) -> Option<bool> {
         self.int(section, key).map(|v| v != 0)
     }
@@ -197,7 +224,7 @@ impl<'a> Lowering<'a> {
             .map(|s| {
                 let s = Some(s);
                 Commissioning {
-                    node_id: self.uint(s, "NodeID"),
+                    node_id: self.node_id(s),
                     node_name: Self::text(s, "NodeName"),
                     baud_rate: self.uint(s, "Baudrate"),
                     net_number: self.uint(s, "NetNumber"),

@@ -1,7 +1,7 @@
 //! Literals of CiA 306: integers (decimal, `0x` hex, leading-`0` octal),
 //! `$NODEID` formulas, REAL values (decimal or hex bit pattern), hex strings.
 
-use crate::ir::{DataType, Literal, Value, ValueKind};
+use crate::ir::{DataType, Literal, Value, ValueKind, node_formula_problem};
 
 /// Why a literal could not be read.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -134,6 +134,9 @@ pub fn parse_real(text: &str, bits: u32) -> Result<f64, LiteralError> {
 pub struct Parsed {
     pub literal: Literal,
     pub warning: Option<String>,
+    /// The warning is about a `$NODEID` formula that fits some node ids
+    /// (but not all): a problem of some configurations, not of the value.
+    pub fits_some_node_ids: bool,
 }
 
 /// Reads `text` as a value of `data_type`. `None` for an unknown data type.
@@ -148,7 +151,12 @@ pub fn parse_value(text: &str, data_type: DataType) -> Option<Result<Parsed, Lit
         ValueKind::Integer { signed, bits } => parse_int_expr(text).map(|(v, rel)| {
             let (lo, hi) = data_type.integer_range().expect("integer type has a range");
             let mut warning = None;
+            let mut fits_some_node_ids = false;
             let mut v = v;
+            if rel && let Some((w, some)) = node_formula_problem(text, v, data_type) {
+                warning = Some(w);
+                fits_some_node_ids = some;
+            }
             if !rel && (v < lo || v > hi) {
                 let is_hex = text
                     .trim()
@@ -169,19 +177,23 @@ pub fn parse_value(text: &str, data_type: DataType) -> Option<Result<Parsed, Lit
             Parsed {
                 literal: literal(Value::Integer(v), rel),
                 warning,
+                fits_some_node_ids,
             }
         }),
         ValueKind::Real { bits } => parse_real(text, bits).map(|v| Parsed {
             literal: literal(Value::Real(v), false),
             warning: None,
+            fits_some_node_ids: false,
         }),
         ValueKind::Text => Ok(Parsed {
             literal: literal(Value::Text(text.to_string()), false),
             warning: None,
+            fits_some_node_ids: false,
         }),
         ValueKind::Bytes => parse_hex_bytes(text).map(|b| Parsed {
             literal: literal(Value::Bytes(b), false),
             warning: None,
+            fits_some_node_ids: false,
         }),
     })
 }

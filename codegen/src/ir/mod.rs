@@ -18,7 +18,9 @@ pub use semantics::{
     BitField, EntryOverride, ErrorCode, ErrorTable, ErrorTableKind, Lss, LssService, NamedValue,
     Network, Pattern, PdoDirection, PdoLabel, Semantics, ValueTable, Variant,
 };
-pub use value::{Literal, Value};
+pub use value::{
+    Literal, NODE_IDS, Value, fitting_node_ids, node_formula_problem, node_value_problems,
+};
 
 /// Whether a device takes the built-in meanings of CiA 301 and its device
 /// profile (bit fields, states, named values, units of the standard

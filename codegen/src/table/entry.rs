@@ -7,6 +7,7 @@ use serde_saphyr::Spanned;
 
 use super::schema::{EntryDef, KindDef, Text};
 use super::{At, Ctx, place};
+use crate::diag::Severity;
 use crate::eds::number;
 use crate::r#gen::rust::naming::{Case, sanitize};
 use crate::ir::{Access, DataType, Device, Entry, Literal, Object, ObjectKind, Value};
@@ -440,6 +441,12 @@ pub(super) fn literal(
     match number::parse_value(t, data_type) {
         Some(Ok(parsed)) => match parsed.warning {
             None => Some(parsed.literal),
+            // A formula that fits some node ids is kept: the node id decides.
+            Some(warning) if parsed.fits_some_node_ids => {
+                let code = "table::value-out-of-range";
+                ctx.report(Severity::Warning, code, at, here, Some(key), warning);
+                Some(parsed.literal)
+            }
             Some(warning) => {
                 ctx.error("table::value-out-of-range", at, here, key, warning);
                 None

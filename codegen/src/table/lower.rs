@@ -93,8 +93,26 @@ pub(super) fn lower(ctx: &mut Ctx, table: &Table, base: Base, files: &mut Vec<Pa
             }
         }
     } else {
+        let mut emptied_by = None;
         for def in &table.delete {
+            let had_objects = !device.objects.is_empty();
             super::entry::delete(ctx, &mut device, def);
+            if had_objects && device.objects.is_empty() {
+                emptied_by = Some(def);
+            }
+        }
+        if let Some(def) = emptied_by
+            && table.objects.is_empty()
+        {
+            ctx.error(
+                "table::no-objects",
+                At::of(def),
+                "delete",
+                "",
+                "this `delete` removes the last object of the base, and the table adds none: \
+                 a device needs at least one object (no reader accepts an EDS without one)"
+                    .into(),
+            );
         }
         for def in &table.modify {
             super::entry::modify(ctx, &mut device, def);

@@ -68,6 +68,14 @@ fn merge(
         need(ctx, numeric, At::of(offset), here, "offset", data_type);
         if offset.value.is_finite() {
             out.offset = Some(offset.value);
+        } else {
+            ctx.error(
+                "table::bad-scale",
+                At::of(offset),
+                here,
+                "offset",
+                "`offset` must be a finite number".into(),
+            );
         }
     }
     if let Some(values) = &d.values {

@@ -13,6 +13,7 @@ mod lower;
 mod meaning;
 mod pdo;
 pub mod schema;
+mod yaml_error;
 
 use std::path::Path;
 
@@ -133,7 +134,7 @@ fn read_table(file: &str, bytes: &[u8], base: Base) -> Loaded {
         }
         Err(err) => {
             let at = err.location().map(|l| At::from_location(&l));
-            let message = first_line(&err.to_string());
+            let message = yaml_error::message(&err).unwrap_or_else(|| first_line(&err.to_string()));
             let mut notes = Vec::new();
             if let Some(suggestion) = levels::did_you_mean(&message) {
                 notes.push(suggestion);

@@ -497,6 +497,10 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
     let Ok(value) = u32::try_from(value) else {
         return TokenStream::new();
     };
+    // `cob_id(node_id)` adds the node id: only when every node id fits.
+    if literal.plus_node_id && value > u32::MAX - 127 {
+        return TokenStream::new();
+    }
     let value_lit = prim::hex(u128::from(value));
     let text = docs::text(&literal.text);
     if literal.plus_node_id {
