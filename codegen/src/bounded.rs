@@ -89,7 +89,7 @@ impl Refused {
 /// `67108864 bytes (64 MiB)`, or just the bytes when not whole MiB.
 fn human(bytes: u64) -> String {
     const MIB: u64 = 1024 * 1024;
-    if bytes >= MIB && bytes % MIB == 0 {
+    if bytes >= MIB && bytes.is_multiple_of(MIB) {
         format!("{bytes} bytes ({} MiB)", bytes / MIB)
     } else {
         format!("{bytes} bytes")

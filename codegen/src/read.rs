@@ -99,16 +99,16 @@ impl Loaded {
     /// Reads the input file at `path` through [`crate::bounded::read_input`]
     /// with the limit of `options`; `Err` is the refusal as a [`Loaded`]
     /// without a device.
-    pub(crate) fn read_bounded(path: &Path, options: &Options) -> Result<Vec<u8>, Loaded> {
+    pub(crate) fn read_bounded(path: &Path, options: &Options) -> Result<Vec<u8>, Box<Loaded>> {
         crate::bounded::read_input(path, options.max_input_size).map_err(|refused| {
             let mut diagnostics = Diagnostics::new();
             diagnostics.push(refused.diagnostic(&path.display().to_string()));
-            Loaded {
+            Box::new(Loaded {
                 device: None,
                 diagnostics,
                 files: Vec::new(),
                 levels: Levels::new(),
-            }
+            })
         })
     }
 

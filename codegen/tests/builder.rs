@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use eds2rust::build::{Report, cargo_lines, generate_device, generate_device_reading};
+use eds2rust::build::{Report, cargo_lines, generate_device_reading};
 use eds2rust::diag::Severity;
 use eds2rust::r#gen::rust::Options as GenOptions;
 use eds2rust::input::{Options, read_device};
@@ -306,7 +306,7 @@ fn files_read_include_a_tables_base_each_once_in_order() {
     // refused unless allowed.
     let refused = read_device(&table, &Options::default());
     assert_eq!(codes_of(&refused.diagnostics), ["table::base-outside"]);
-    assert_eq!(refused.files, [table.clone()]);
+    assert_eq!(refused.files, std::slice::from_ref(&table));
     let allowed = Options {
         allow_base_dirs: vec![dir.clone()],
         ..Options::default()

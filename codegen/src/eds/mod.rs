@@ -33,7 +33,7 @@ pub(crate) fn read_file_unfinished(path: &Path, options: &Options) -> Loaded {
     let name = path.display().to_string();
     match Loaded::read_bounded(path, options) {
         Ok(bytes) => read_bytes_unfinished(&name, &bytes),
-        Err(refused) => refused,
+        Err(refused) => *refused,
     }
     .read_first(path)
 }

@@ -37,7 +37,7 @@ pub(crate) fn read_file_unfinished(path: &Path, options: &Options) -> Loaded {
             let dir = path.parent().unwrap_or(Path::new(""));
             read_table(&name, &bytes, Base::Key(dir, options))
         }
-        Err(refused) => refused,
+        Err(refused) => *refused,
     }
     .read_first(path)
 }
@@ -73,7 +73,7 @@ pub(crate) fn apply_overlay_unfinished(base: Device, path: &Path, options: &Opti
     let name = path.display().to_string();
     match Loaded::read_bounded(path, options) {
         Ok(bytes) => read_table(&name, &bytes, Base::Given(Box::new(base))),
-        Err(refused) => refused,
+        Err(refused) => *refused,
     }
     .read_first(path)
 }
