@@ -171,6 +171,14 @@ struct ReadArgs {
     /// Make the warnings of this rule errors; may be given several times.
     #[arg(long, value_name = "CODE")]
     deny: Vec<String>,
+    /// The largest input file read, in bytes (default 64 MiB); a larger
+    /// one is an error.
+    #[arg(long, value_name = "BYTES", default_value_t = eds2rust::read::DEFAULT_MAX_INPUT_SIZE)]
+    max_input_size: u64,
+    /// Let a YAML table's `base:` name files in DIR too (by default only
+    /// files under the current directory); may be given several times.
+    #[arg(long, value_name = "DIR")]
+    allow_base_dir: Vec<PathBuf>,
 }
 
 impl ReadArgs {
@@ -193,6 +201,9 @@ impl ReadArgs {
         Ok(Options {
             strict: self.strict,
             levels,
+            max_input_size: self.max_input_size,
+            project_dir: None,
+            allow_base_dirs: self.allow_base_dir.clone(),
         })
     }
 }
@@ -292,7 +303,7 @@ fn main() -> ExitCode {
                     .unwrap_or_else(|| eds2rust::r#gen::rust::Options::default().runtime_path),
                 strict: options.strict,
             },
-            &options.levels,
+            &options,
         ),
         Command::Api { overlays, file, .. } => api(&file, &overlays, &options),
         Command::Diff {
@@ -460,9 +471,9 @@ fn generate(
     overlays: &[PathBuf],
     output: Option<&std::path::Path>,
     options: &eds2rust::r#gen::rust::Options,
-    levels: &Levels,
+    read: &Options,
 ) -> ExitCode {
-    let generated = eds2rust::build::generate_device_with(path, overlays, options, levels);
+    let generated = eds2rust::build::generate_device_reading(path, overlays, options, read);
     let code = match generated.result {
         Ok(out) => {
             let _ = write!(std::io::stderr().lock(), "{}", out.warnings.render());

@@ -31,14 +31,15 @@ impl InputKind {
 
 /// Reads an EDS/DCF file or a YAML object table from disk.
 pub fn read_device(path: &Path, options: &Options) -> Loaded {
-    read_unfinished(path).finish(options)
+    read_unfinished(path, options).finish(options)
 }
 
 /// [`read_device`] before the levels and strictness are applied: for
-/// callers that apply overlays first and then all levels at once.
-pub(crate) fn read_unfinished(path: &Path) -> Loaded {
+/// callers that apply overlays first and then all levels at once. The size
+/// limit and the `base:` directories of `options` apply.
+pub(crate) fn read_unfinished(path: &Path, options: &Options) -> Loaded {
     match InputKind::of(path) {
-        InputKind::Eds => crate::eds::read_file_unfinished(path),
-        InputKind::Table => crate::table::read_file_unfinished(path),
+        InputKind::Eds => crate::eds::read_file_unfinished(path, options),
+        InputKind::Table => crate::table::read_file_unfinished(path, options),
     }
 }

@@ -18,6 +18,7 @@
 //!   prost-build) and the pure [`generate`]: input + overlays → Rust source.
 #![forbid(unsafe_code)]
 
+pub mod bounded;
 pub mod build;
 pub mod diag;
 pub mod diff;

@@ -5,17 +5,40 @@
 
 use std::path::{Path, PathBuf};
 
+pub use crate::bounded::DEFAULT_MAX_INPUT_SIZE;
 use crate::diag::{Diagnostic, Diagnostics, Levels, Location, Severity};
 use crate::ir::Device;
 
-/// How strictly to read.
-#[derive(Debug, Clone, Default, PartialEq, Eq)]
+/// How strictly to read, and how much and where.
+#[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Options {
     /// Turn every warning into an error, but those of allowed rules.
     pub strict: bool,
     /// The caller's rule levels (`--allow`, `--deny`, `Builder::allow`):
     /// they win over a YAML table's `diagnostics:` section.
     pub levels: Levels,
+    /// The largest input file read, in bytes (default
+    /// [`DEFAULT_MAX_INPUT_SIZE`], 64 MiB); a larger one is an error
+    /// (`input::too-large`).
+    pub max_input_size: u64,
+    /// The project a YAML table's `base:` must lie in (`None`: the current
+    /// directory, where cargo runs build scripts and tests).
+    pub project_dir: Option<PathBuf>,
+    /// More directories a `base:` may lie in (`--allow-base-dir`,
+    /// `Builder::allow_base_dir`).
+    pub allow_base_dirs: Vec<PathBuf>,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            strict: false,
+            levels: Levels::default(),
+            max_input_size: DEFAULT_MAX_INPUT_SIZE,
+            project_dir: None,
+            allow_base_dirs: Vec::new(),
+        }
+    }
 }
 
 impl Options {
@@ -71,6 +94,22 @@ impl Loaded {
             files: Vec::new(),
             levels: Levels::new(),
         }
+    }
+
+    /// Reads the input file at `path` through [`crate::bounded::read_input`]
+    /// with the limit of `options`; `Err` is the refusal as a [`Loaded`]
+    /// without a device.
+    pub(crate) fn read_bounded(path: &Path, options: &Options) -> Result<Vec<u8>, Box<Loaded>> {
+        crate::bounded::read_input(path, options.max_input_size).map_err(|refused| {
+            let mut diagnostics = Diagnostics::new();
+            diagnostics.push(refused.diagnostic(&path.display().to_string()));
+            Box::new(Loaded {
+                device: None,
+                diagnostics,
+                files: Vec::new(),
+                levels: Levels::new(),
+            })
+        })
     }
 
     /// Records that `path` was read (or tried), in front of the files

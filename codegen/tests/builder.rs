@@ -7,7 +7,7 @@
 
 use std::path::{Path, PathBuf};
 
-use eds2rust::build::{Report, cargo_lines, generate_device};
+use eds2rust::build::{Report, cargo_lines, generate_device_reading};
 use eds2rust::diag::Severity;
 use eds2rust::r#gen::rust::Options as GenOptions;
 use eds2rust::input::{Options, read_device};
@@ -51,7 +51,11 @@ fn build(builder: &mut Builder) -> Result<Report, Error> {
 }
 
 fn codes(err: &Error) -> Vec<&'static str> {
-    err.diagnostics().iter().map(|d| d.code).collect()
+    codes_of(err.diagnostics())
+}
+
+fn codes_of(d: &eds2rust::diag::Diagnostics) -> Vec<&'static str> {
+    d.iter().map(|d| d.code).collect()
 }
 
 /// An EDS with warnings only (a repeated key at line 6, an object not
@@ -298,7 +302,16 @@ fn files_read_include_a_tables_base_each_once_in_order() {
     );
     let overlay = write(&dir, "overlay.yaml", OVERLAY);
 
-    let loaded = read_device(&table, &Options::default());
+    // The scratch directory lies outside the project: its `base:` is
+    // refused unless allowed.
+    let refused = read_device(&table, &Options::default());
+    assert_eq!(codes_of(&refused.diagnostics), ["table::base-outside"]);
+    assert_eq!(refused.files, std::slice::from_ref(&table));
+    let allowed = Options {
+        allow_base_dirs: vec![dir.clone()],
+        ..Options::default()
+    };
+    let loaded = read_device(&table, &allowed);
     assert!(loaded.diagnostics.is_empty(), "{}", loaded.diagnostics);
     assert_eq!(loaded.files, [table.clone(), base.clone()]);
     assert_eq!(
@@ -306,10 +319,11 @@ fn files_read_include_a_tables_base_each_once_in_order() {
         [base.as_path()]
     );
 
-    let generated = generate_device(
+    let generated = generate_device_reading(
         &table,
         std::slice::from_ref(&overlay),
         &GenOptions::default(),
+        &allowed,
     );
     assert!(generated.result.is_ok());
     assert_eq!(
@@ -324,6 +338,7 @@ fn files_read_include_a_tables_base_each_once_in_order() {
         .overlay(&overlay)
         .device("second", &base)
         .overlay(&overlay)
+        .allow_base_dir(&dir)
         .out_dir(dir.join("gen"));
     let report = build(&mut builder).unwrap();
     let expected = [table, base, overlay];

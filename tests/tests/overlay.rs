@@ -18,7 +18,14 @@ fn load() -> Option<(Device, Device)> {
     let base_path = shared.join("eds-corpus/files/esacademy_cia402-stepper-node8.eds");
     let overlay_path = workspace_root().join("tests/overlays/cia402_stepper.yaml");
     let base = read_device(&base_path, &Options::default());
-    let overlay = read_device(&overlay_path, &Options::default());
+    // The overlay's `base:` lies outside the checkout, in ../shared.
+    let overlay = read_device(
+        &overlay_path,
+        &Options {
+            allow_base_dirs: vec![shared.clone()],
+            ..Options::default()
+        },
+    );
     assert!(
         !overlay.diagnostics.has_errors() && overlay.diagnostics.warning_count() == 0,
         "{}",

@@ -4,9 +4,9 @@ use std::collections::HashSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use super::cargo::{cargo_lines, in_build_script};
+use super::cargo::{cargo_lines, in_build_script, project_dir};
 use super::files::write_if_changed;
-use super::{Error, error, generate_device_with, push_unique};
+use super::{Error, error, generate_device_reading, push_unique};
 use crate::diag::{Diagnostics, Levels};
 use crate::r#gen::rust::Options;
 
@@ -26,6 +26,8 @@ pub struct Builder {
     strict: bool,
     levels: Levels,
     cargo_output: Option<bool>,
+    max_input_size: Option<u64>,
+    allow_base_dirs: Vec<PathBuf>,
 }
 
 #[derive(Debug, Clone)]
@@ -139,6 +141,24 @@ impl Builder {
         self
     }
 
+    /// The largest input file read, in bytes (default
+    /// [`DEFAULT_MAX_INPUT_SIZE`](crate::read::DEFAULT_MAX_INPUT_SIZE),
+    /// 64 MiB); a larger one is an error (`input::too-large`).
+    pub fn max_input_size(&mut self, bytes: u64) -> &mut Self {
+        self.max_input_size = Some(bytes);
+        self
+    }
+
+    /// Lets a YAML table's `base:` name files in `dir` too. By default a
+    /// `base:` must lie inside the project: the workspace of the package
+    /// being built (see [`project_dir`](super::project_dir)), or the
+    /// current directory outside cargo; otherwise it is an error
+    /// (`table::base-outside`) and the file is not read.
+    pub fn allow_base_dir(&mut self, dir: impl AsRef<Path>) -> &mut Self {
+        self.allow_base_dirs.push(dir.as_ref().to_path_buf());
+        self
+    }
+
     /// Whether [`generate`](Builder::generate) prints the `cargo:` lines;
     /// by default it does exactly when [`in_build_script`].
     pub fn cargo_output(&mut self, print: bool) -> &mut Self {
@@ -216,6 +236,15 @@ impl Builder {
                 .unwrap_or_else(|| Options::default().runtime_path),
             strict: self.strict,
         };
+        let read = crate::read::Options {
+            strict: self.strict,
+            levels: self.levels.clone(),
+            max_input_size: self
+                .max_input_size
+                .unwrap_or(crate::read::DEFAULT_MAX_INPUT_SIZE),
+            project_dir: project_dir(),
+            allow_base_dirs: self.allow_base_dirs.clone(),
+        };
         let mut names = HashSet::new();
         let mut outputs = Vec::new();
         for device in &self.devices {
@@ -229,7 +258,7 @@ impl Builder {
                 ));
             }
             let generated =
-                generate_device_with(&device.input, &device.overlays, &options, &self.levels);
+                generate_device_reading(&device.input, &device.overlays, &options, &read);
             push_unique(&mut report.files_read, generated.files);
             match generated.result {
                 Ok(output) => {

@@ -16,6 +16,22 @@ pub fn in_build_script() -> bool {
     std::env::var_os("CARGO").is_some() && std::env::var_os("OUT_DIR").is_some()
 }
 
+/// The project a build script builds, where a YAML table's `base:` may
+/// lead: the workspace around the package of `CARGO_MANIFEST_DIR` (the
+/// nearest directory at or above it whose `Cargo.toml` has a `[workspace]`
+/// table), else the package's directory; `None` outside cargo.
+pub fn project_dir() -> Option<PathBuf> {
+    let package = PathBuf::from(std::env::var_os("CARGO_MANIFEST_DIR")?);
+    let workspace = package.ancestors().find(|dir| {
+        crate::bounded::read_input(&dir.join("Cargo.toml"), 1 << 20).is_ok_and(|bytes| {
+            String::from_utf8_lossy(&bytes)
+                .lines()
+                .any(|line| line.trim() == "[workspace]")
+        })
+    });
+    Some(workspace.map_or(package.clone(), Path::to_path_buf))
+}
+
 /// The `cargo:` lines for `files` read and `warnings`: a
 /// `cargo:rerun-if-changed=` line per file, in the order given, then the
 /// warnings. A rule with one warning gets a line of its own

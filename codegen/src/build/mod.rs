@@ -44,7 +44,7 @@ use crate::ir::Device;
 use crate::read::Loaded;
 
 pub use builder::{Builder, Report, WARNINGS_FILE};
-pub use cargo::{cargo_lines, error_lines, in_build_script};
+pub use cargo::{cargo_lines, error_lines, in_build_script, project_dir};
 pub use error::Error;
 pub use files::write_whole;
 
@@ -97,7 +97,26 @@ pub fn generate_device_with(
     options: &Options,
     levels: &Levels,
 ) -> Generated {
-    let loaded = load(input, overlays);
+    let read = crate::read::Options {
+        levels: levels.clone(),
+        ..crate::read::Options::default()
+    };
+    generate_device_reading(input, overlays, options, &read)
+}
+
+/// [`generate_device_with`] with every reading option: the rule levels
+/// `read.levels`, the size limit of an input file and where a YAML table's
+/// `base:` may lead. Warnings are errors when `options.strict` or
+/// `read.strict` is set.
+pub fn generate_device_reading(
+    input: &Path,
+    overlays: &[PathBuf],
+    options: &Options,
+    read: &crate::read::Options,
+) -> Generated {
+    let levels = &read.levels;
+    let strict = options.strict || read.strict;
+    let loaded = load(input, overlays, read);
     let mut diagnostics = loaded.diagnostics;
     let mut code = None;
     if let Some(device) = &loaded.device
@@ -115,7 +134,7 @@ pub fn generate_device_with(
             Err(errors) => diagnostics.extend(errors),
         }
     }
-    diagnostics.apply_levels(&loaded.levels.merged(levels), options.strict);
+    diagnostics.apply_levels(&loaded.levels.merged(levels), strict);
     diagnostics.sort();
     let result = match code {
         Some(code) if !diagnostics.has_errors() => Ok(Output {
@@ -137,7 +156,7 @@ pub fn generate_device_with(
 /// `options.strict` applied, the files read and the merged file levels. For
 /// tools that work on the loaded IR (`eds2rust diff`).
 pub fn load_device(input: &Path, overlays: &[PathBuf], options: &crate::read::Options) -> Loaded {
-    let loaded = load(input, overlays);
+    let loaded = load(input, overlays, options);
     let mut diagnostics = loaded.diagnostics;
     diagnostics.apply_levels(&loaded.levels.merged(&options.levels), options.strict);
     diagnostics.sort();
@@ -198,9 +217,11 @@ struct LoadedDevice {
     levels: Levels,
 }
 
-/// Reads the input and applies the overlays, until the first error.
-fn load(input: &Path, overlays: &[PathBuf]) -> LoadedDevice {
-    let loaded = read_unfinished(input);
+/// Reads the input and applies the overlays, until the first error; the
+/// size limit and the `base:` directories of `read` apply (its levels and
+/// strictness do not, yet).
+fn load(input: &Path, overlays: &[PathBuf], read: &crate::read::Options) -> LoadedDevice {
+    let loaded = read_unfinished(input, read);
     let mut files = Vec::new();
     push_unique(&mut files, loaded.files);
     let mut diagnostics = loaded.diagnostics;
@@ -219,7 +240,7 @@ fn load(input: &Path, overlays: &[PathBuf]) -> LoadedDevice {
             ));
             break;
         }
-        let loaded = crate::table::apply_overlay_unfinished(base, overlay);
+        let loaded = crate::table::apply_overlay_unfinished(base, overlay, read);
         push_unique(&mut files, loaded.files);
         diagnostics.extend(loaded.diagnostics);
         levels = levels.merged(&loaded.levels);

@@ -148,6 +148,14 @@ pub const RULES: &[Rule] = &[
         "a `rust_name:` pin equal to another name in its scope",
     ),
     rule(
+        "input::not-a-file",
+        "an input that is not a regular file (directory, FIFO, device, /proc)",
+    ),
+    rule(
+        "input::too-large",
+        "an input file above the size limit (--max-input-size)",
+    ),
+    rule(
         "table::array-type",
         "an ARRAY whose subs do not share one type",
     ),
@@ -176,6 +184,10 @@ pub const RULES: &[Rule] = &[
     rule(
         "table::base",
         "a base EDS that could not be read without errors",
+    ),
+    rule(
+        "table::base-outside",
+        "a `base:` outside the project and the allowed directories",
     ),
     rule(
         "table::bit-field",
@@ -350,7 +362,7 @@ mod tests {
                     let Some((area, name)) = word.split_once("::") else {
                         continue;
                     };
-                    let is_code = ["build", "eds", "gen", "table"].contains(&area)
+                    let is_code = ["build", "eds", "gen", "input", "table"].contains(&area)
                         && !name.is_empty()
                         && name
                             .bytes()

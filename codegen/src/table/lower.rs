@@ -31,14 +31,14 @@ pub(super) fn lower(ctx: &mut Ctx, table: &Table, base: Base, files: &mut Vec<Pa
     }
     let has_base = table.base.is_some() || matches!(base, Base::Given(_));
     let mut device = match (base, &table.base) {
-        (Base::Key(base_dir), Some(key)) => {
-            match read_base(ctx, key, base_dir, files) {
+        (Base::Key(base_dir, options), Some(key)) => {
+            match read_base(ctx, key, base_dir, options, files) {
                 Some(device) => device,
                 // Every later stage would only repeat that the base is missing.
                 None => return Device::default(),
             }
         }
-        (Base::Key(_), None) => whole_device_start(ctx, table),
+        (Base::Key(..), None) => whole_device_start(ctx, table),
         (Base::Given(device), key) => {
             if let Some(key) = key {
                 ctx.error(
@@ -172,10 +172,25 @@ fn read_base(
     ctx: &mut Ctx,
     base: &Spanned<String>,
     base_dir: &Path,
+    options: &crate::read::Options,
     files: &mut Vec<PathBuf>,
 ) -> Option<Device> {
     let path = base_dir.join(&base.value);
-    let loaded = crate::eds::read_file_unfinished(&path);
+    let inside = crate::bounded::check_base(
+        &path,
+        options.project_dir.as_deref(),
+        &options.allow_base_dirs,
+    );
+    if let Err(message) = inside {
+        ctx.error("table::base-outside", At::of(base), "", "base", message);
+        ctx.note(
+            "allow a directory with `--allow-base-dir DIR` (command line), \
+             `Builder::allow_base_dir` (build script) or `Options::allow_base_dirs` (library)"
+                .into(),
+        );
+        return None;
+    }
+    let loaded = crate::eds::read_file_unfinished(&path, options);
     files.extend(loaded.files);
     let failed = loaded.diagnostics.has_errors();
     ctx.diags.extend(loaded.diagnostics);

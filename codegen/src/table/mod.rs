@@ -26,26 +26,28 @@ use crate::read::{Loaded, Options};
 /// Reads a YAML object table from disk. A `base:` EDS is read relative to
 /// the table's directory.
 pub fn read_file(path: &Path, options: &Options) -> Loaded {
-    read_file_unfinished(path).finish(options)
+    read_file_unfinished(path, options).finish(options)
 }
 
-/// [`read_file`] before levels and strictness are applied.
-pub(crate) fn read_file_unfinished(path: &Path) -> Loaded {
+/// [`read_file`] before levels and strictness are applied (but with the
+/// size limit and the `base:` directories of `options`).
+pub(crate) fn read_file_unfinished(path: &Path, options: &Options) -> Loaded {
     let name = path.display().to_string();
-    match std::fs::read(path) {
+    match Loaded::read_bounded(path, options) {
         Ok(bytes) => {
             let dir = path.parent().unwrap_or(Path::new(""));
-            read_table(&name, &bytes, Base::Key(dir))
+            read_table(&name, &bytes, Base::Key(dir, options))
         }
-        Err(err) => Loaded::unreadable(name, &err),
+        Err(refused) => *refused,
     }
     .read_first(path)
 }
 
 /// Reads YAML table content; `file` names it in diagnostics and origins,
-/// `base_dir` is where a `base:` path is resolved.
+/// `base_dir` is where a `base:` path is resolved (it must lead inside
+/// `options.project_dir` or `options.allow_base_dirs`).
 pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: &Options) -> Loaded {
-    read_table(file, bytes, Base::Key(base_dir)).finish(options)
+    read_table(file, bytes, Base::Key(base_dir, options)).finish(options)
 }
 
 /// Reads the YAML overlay table at `path` and applies it on `base`, a device
@@ -63,24 +65,25 @@ pub fn read_bytes(file: &str, bytes: &[u8], base_dir: &Path, options: &Options) 
 /// (but for its own `diagnostics:` section, in [`Loaded::levels`], which the
 /// caller applies to the whole device).
 pub fn apply_overlay(base: Device, path: &Path, options: &Options) -> Loaded {
-    apply_overlay_unfinished(base, path).finish(options)
+    apply_overlay_unfinished(base, path, options).finish(options)
 }
 
-/// [`apply_overlay`] before levels and strictness are applied.
-pub(crate) fn apply_overlay_unfinished(base: Device, path: &Path) -> Loaded {
+/// [`apply_overlay`] before levels and strictness are applied (but with the
+/// size limit of `options`).
+pub(crate) fn apply_overlay_unfinished(base: Device, path: &Path, options: &Options) -> Loaded {
     let name = path.display().to_string();
-    match std::fs::read(path) {
+    match Loaded::read_bounded(path, options) {
         Ok(bytes) => read_table(&name, &bytes, Base::Given(Box::new(base))),
-        Err(err) => Loaded::unreadable(name, &err),
+        Err(refused) => *refused,
     }
     .read_first(path)
 }
 
 /// Where the device a table starts from comes from.
 pub(crate) enum Base<'a> {
-    /// The table's own `base:` key, resolved in this directory; without the
-    /// key, the table is a whole device.
-    Key(&'a Path),
+    /// The table's own `base:` key, resolved in this directory and read
+    /// with these options; without the key, the table is a whole device.
+    Key(&'a Path, &'a Options),
     /// Given by the caller: the table is an overlay on it.
     Given(Box<Device>),
 }

@@ -34,19 +34,136 @@ pub fn base_dir() -> &'static Path {
     })
 }
 
-/// The EDS/DCF reader on raw bytes (it decodes UTF-8 and Latin-1 itself).
+/// The reading options of the bodies: lenient, the project being
+/// [`base_dir`] (wherever the fuzzer runs), so that a `base:` may lead only
+/// there.
+fn options() -> Options {
+    Options {
+        project_dir: Some(base_dir().to_path_buf()),
+        ..Options::lenient()
+    }
+}
+
+/// The EDS/DCF reader on raw bytes (it decodes UTF-8 and Latin-1 itself),
+/// then the same bytes from a file through the bounded reader ([`size_limit`]).
 pub fn eds_reader(data: &[u8]) {
-    let loaded = eds2rust::eds::read_bytes(EDS_NAME, data, &Options::lenient());
+    let loaded = eds2rust::eds::read_bytes(EDS_NAME, data, &options());
     check_loaded(&loaded, EDS_NAME);
     build(&loaded);
+    size_limit(data);
 }
 
 /// The YAML table reader on raw bytes (it rejects what is not UTF-8 with a
-/// diagnostic); a `base:` is resolved in [`base_dir`].
+/// diagnostic); a `base:` is resolved in [`base_dir`]. Then the bytes as
+/// the path of a `base:` ([`hostile_base`]).
 pub fn yaml_reader(data: &[u8]) {
-    let loaded = eds2rust::table::read_bytes(YAML_NAME, data, base_dir(), &Options::lenient());
+    let loaded = eds2rust::table::read_bytes(YAML_NAME, data, base_dir(), &options());
     check_loaded(&loaded, YAML_NAME);
+    check_confined(&loaded);
     build(&loaded);
+    hostile_base(data);
+}
+
+/// Paths an attacker would name in `base:`; each fuzz input is tried as a
+/// path on its own and appended to each of these.
+const HOSTILE_BASES: &[&str] = &[
+    "../../../..",
+    "../../../../Cargo.toml",
+    "../../../../../../../../../../etc/passwd",
+    "/etc/passwd",
+    "/dev/zero",
+    "/dev/stdin",
+    "/proc/self/environ",
+    "/sys/kernel/notes",
+    "/",
+];
+
+/// A table whose `base:` is a hostile path or the data itself (one line,
+/// quoted as a YAML string): the reader returns, reads no file outside
+/// [`base_dir`] and quotes nothing of the environment.
+pub fn hostile_base(data: &[u8]) {
+    let text = String::from_utf8_lossy(data);
+    let line: String = text.chars().take(256).filter(|c| !c.is_control()).collect();
+    let mut paths = vec![line.clone()];
+    for hostile in HOSTILE_BASES {
+        paths.push(hostile.to_string());
+        paths.push(format!("{hostile}/{line}"));
+    }
+    for path in paths {
+        let quoted = path.replace('\\', "\\\\").replace('"', "\\\"");
+        let table = format!("format: 1\nbase: \"{quoted}\"\n");
+        let loaded =
+            eds2rust::table::read_bytes(YAML_NAME, table.as_bytes(), base_dir(), &options());
+        check_loaded(&loaded, YAML_NAME);
+        check_confined(&loaded);
+    }
+}
+
+/// Every file the result lists (read or tried) lies inside [`base_dir`] or
+/// does not exist, and no diagnostic quotes a variable of the environment
+/// (what `/proc/self/environ` holds).
+fn check_confined(loaded: &Loaded) {
+    static ROOT: OnceLock<PathBuf> = OnceLock::new();
+    let root = ROOT.get_or_init(|| std::fs::canonicalize(base_dir()).expect("base_dir"));
+    for file in &loaded.files {
+        if let Ok(real) = std::fs::canonicalize(file) {
+            assert!(
+                real.starts_with(root),
+                "a file outside the allowed directory was read: {}",
+                real.display()
+            );
+        }
+    }
+    let rendered = loaded.diagnostics.render();
+    for (key, value) in std::env::vars() {
+        if value.len() >= 8 {
+            let pair = format!("{key}={value}");
+            assert!(
+                !rendered.contains(&pair),
+                "the environment is quoted ({key})"
+            );
+        }
+    }
+}
+
+/// The limit of [`size_limit`]: small, so that the fuzzer's inputs cross it.
+const TINY_LIMIT: u64 = 64;
+
+/// The data written to a file and read back through the bounded reader
+/// with a tiny limit: the bytes come back exactly when they fit, and
+/// `input::too-large` is reported exactly when they do not.
+pub fn size_limit(data: &[u8]) {
+    static N: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
+    let n = N.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let path =
+        std::env::temp_dir().join(format!("eds2rust-fuzz-size-{}-{n}.eds", std::process::id()));
+    std::fs::write(&path, data).expect("write the temporary file");
+    let len = u64::try_from(data.len()).unwrap_or(u64::MAX);
+    let read = eds2rust::bounded::read_input(&path, TINY_LIMIT);
+    if len <= TINY_LIMIT {
+        assert_eq!(read.expect("a file within the limit is read"), data);
+    } else {
+        assert!(
+            matches!(read, Err(eds2rust::bounded::Refused::TooLarge { .. })),
+            "a file above the limit is refused"
+        );
+    }
+    let options = Options {
+        max_input_size: TINY_LIMIT,
+        ..options()
+    };
+    let loaded = eds2rust::eds::read_file(&path, &options);
+    let _ = std::fs::remove_file(&path);
+    let too_large = loaded
+        .diagnostics
+        .iter()
+        .any(|d| d.code == "input::too-large");
+    assert_eq!(
+        too_large,
+        len > TINY_LIMIT,
+        "input::too-large iff above the limit"
+    );
+    check_loaded(&loaded, "size");
 }
 
 /// What holds for every result of reading: a device unless nothing could be
