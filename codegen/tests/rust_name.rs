@@ -421,8 +421,14 @@ delete:
 ",
     )
     .expect("write");
-    let loaded = read_file(&overlay, &Options::default());
-    let bad = read_file(&misplaced, &Options::default());
+    // The scratch directory is the project here: a `base:` outside the
+    // project is refused.
+    let options = Options {
+        project_dir: Some(dir.clone()),
+        ..Options::default()
+    };
+    let loaded = read_file(&overlay, &options);
+    let bad = read_file(&misplaced, &options);
     let _ = std::fs::remove_dir_all(&dir);
     // `delete:` has no names to pin.
     assert!(
