@@ -315,3 +315,37 @@ fn identity_items(device: &Device) -> TokenStream {
     }
     out
 }
+
+#[cfg(test)]
+mod tests {
+    use super::check_runtime_path;
+
+    #[test]
+    fn runtime_paths() {
+        for ok in [
+            "::eds2rust_runtime",
+            "my::rt",
+            "crate::rt",
+            "self::rt",
+            "super::super::rt",
+            "r#type",
+        ] {
+            assert!(check_runtime_path(ok).is_ok(), "{ok}");
+        }
+        for (bad, why) in [
+            ("Self", "names a type"),
+            ("1abc", "not a Rust identifier"),
+            ("foo::", "ends in `::`"),
+            ("a b", "not a Rust identifier"),
+            ("", "is empty"),
+            ("crate", "only a crate or module name"),
+            ("a::super", "only a crate or module name"),
+            ("::crate::x", "only a crate or module name"),
+            (" x", "spaces"),
+            ("a::::b", "empty segment"),
+        ] {
+            let problem = check_runtime_path(bad).unwrap_err();
+            assert!(problem.contains(why), "{bad:?}: {problem}");
+        }
+    }
+}
