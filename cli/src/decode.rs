@@ -110,10 +110,16 @@ impl NodeFiles {
     }
 }
 
-/// Writes one record in `format`.
+/// Writes one record in `format`. Text is one terminal-safe line: names
+/// from the device files and the trace's own text cannot break the line or
+/// send escape sequences or bidi controls ([`eds2rust::text::terminal_line`]).
 pub fn write_record(out: &mut impl Write, format: OutFormat, record: &Record) -> io::Result<()> {
     match format {
-        OutFormat::Text => writeln!(out, "{}", render::text(record)),
+        OutFormat::Text => writeln!(
+            out,
+            "{}",
+            eds2rust::text::terminal_line(&render::text(record))
+        ),
         OutFormat::Json => {
             render::write_json(&mut *out, record)?;
             out.write_all(b"\n")

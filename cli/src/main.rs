@@ -265,6 +265,20 @@ fn main() -> ExitCode {
             return ExitCode::from(2);
         }
     };
+    if let Command::Generate {
+        runtime_path: Some(path),
+        ..
+    } = &cli.command
+        && let Err(problem) = eds2rust::r#gen::rust::check_runtime_path(path)
+    {
+        let _ = writeln!(
+            std::io::stderr().lock(),
+            "error: --runtime-path `{}` {problem}\n  = {}",
+            eds2rust::text::terminal_line(path),
+            eds2rust::r#gen::rust::RUNTIME_PATH_HELP
+        );
+        return ExitCode::from(2);
+    }
     match cli.command {
         Command::Decode(args) => decode::run(args),
         Command::Monitor(args) => monitor::run(args),
@@ -371,7 +385,9 @@ fn diff(
         DiffFormat::Json => render::json(&old_name, &new_name, &changes),
         DiffFormat::Markdown => render::markdown(&old_name, &new_name, &changes),
     };
-    let _ = std::io::stdout().lock().write_all(text.as_bytes());
+    if let Err(code) = print(&text) {
+        return code;
+    }
     let threshold = match fail_on {
         FailOn::Breaking => Some(Severity::Breaking),
         FailOn::Additive => Some(Severity::Additive),
@@ -388,21 +404,21 @@ fn diff(
 
 fn check(files: &[PathBuf], options: &Options) -> ExitCode {
     let mut failed = false;
-    let stdout = std::io::stdout();
-    let mut out = stdout.lock();
     for path in files {
         let loaded = read_device(path, options);
         let d = &loaded.diagnostics;
-        let _ = write!(out, "{}", d.render());
         let objects = loaded.device.as_ref().map_or(0, |dev| dev.objects.len());
-        let _ = writeln!(
-            out,
-            "{}: {} objects, {} errors, {} warnings",
-            path.display(),
+        let text = format!(
+            "{}{}: {} objects, {} errors, {} warnings\n",
+            d.render(),
+            eds2rust::text::terminal_line(&path.display().to_string()),
             objects,
             d.error_count(),
             d.warning_count()
         );
+        if let Err(code) = print(&text) {
+            return code;
+        }
         failed |= d.has_errors();
     }
     if failed {
@@ -422,8 +438,9 @@ fn dump(path: &std::path::Path, node_id: Option<u8>, options: &Options) -> ExitC
     let json =
         eds2rust::dump::json::to_json(&name, loaded.device.as_ref(), &loaded.diagnostics, node_id);
     let text = serde_json::to_string_pretty(&json).expect("a serde_json::Value always serialises");
-    // A closed pipe (`| head`) is not an error of ours.
-    let _ = writeln!(std::io::stdout().lock(), "{text}");
+    if let Err(code) = print(&format!("{text}\n")) {
+        return code;
+    }
     if loaded.diagnostics.has_errors() {
         ExitCode::from(1)
     } else {
@@ -488,8 +505,10 @@ fn api(path: &std::path::Path, overlays: &[PathBuf], options: &Options) -> ExitC
     match eds2rust::build::api_listing_files(path, overlays, options) {
         Ok(listing) => {
             let _ = write!(std::io::stderr().lock(), "{}", listing.warnings.render());
-            let _ = std::io::stdout().lock().write_all(listing.text.as_bytes());
-            ExitCode::SUCCESS
+            match print(&listing.text) {
+                Ok(()) => ExitCode::SUCCESS,
+                Err(code) => code,
+            }
         }
         Err(diagnostics) => failed(path, diagnostics, "listed"),
     }
@@ -510,13 +529,35 @@ fn failed(path: &std::path::Path, mut diagnostics: Diagnostics, what: &str) -> E
     ExitCode::from(1)
 }
 
-/// Writes `text` to standard output, or whole to `output`.
+/// Writes `text` to standard output and flushes it. A reader that left
+/// (`| head`: a broken pipe) is not an error of ours: the rest is dropped
+/// quietly. Any other failure (`> /dev/full`: no space) is printed, with
+/// exit status 1 as `Err`.
+fn print(text: &str) -> Result<(), ExitCode> {
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Ok(()) => Ok(()),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        Err(e) => {
+            drop(out);
+            let _ = writeln!(
+                std::io::stderr().lock(),
+                "error: cannot write to standard output: {e}"
+            );
+            Err(ExitCode::from(1))
+        }
+    }
+}
+
+/// Writes `text` to standard output ([`print`]), or whole to `output`
+/// ([`eds2rust::build::write_whole`]: atomically, through a symlink, never
+/// over a device, FIFO or directory).
 fn write_output(output: Option<&std::path::Path>, text: &str) -> ExitCode {
     match output {
-        None => {
-            let _ = std::io::stdout().lock().write_all(text.as_bytes());
-            ExitCode::SUCCESS
-        }
+        None => match print(text) {
+            Ok(()) => ExitCode::SUCCESS,
+            Err(code) => code,
+        },
         Some(out) => match eds2rust::build::write_whole(out, text.as_bytes()) {
             Ok(()) => ExitCode::SUCCESS,
             Err(err) => {

@@ -288,6 +288,9 @@ impl Monitor {
             self.frames,
             table.render(t, view == View::Plain)
         );
+        // Names come from the device files: terminal-safe before our own
+        // escape sequences are added.
+        let text = eds2rust::text::terminal(&text).into_owned();
         let text = match view {
             View::Plain => format!("{text}\n"),
             // Home, each line cleared to its end, the rest of the screen cleared.

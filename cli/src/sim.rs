@@ -213,6 +213,7 @@ pub fn simulate(
         stop,
         out,
         err,
+        out_failed: None,
     };
     if drive {
         let model = Cia402::new().with_time_scale(args.time_scale);
@@ -240,6 +241,9 @@ struct Session<'a> {
     stop: &'a AtomicBool,
     out: &'a mut dyn Write,
     err: &'a mut dyn Write,
+    /// The first failed write to `out` other than a closed pipe: the run
+    /// stops and exits 1.
+    out_failed: Option<io::Error>,
 }
 
 impl Session<'_> {
@@ -281,7 +285,10 @@ impl Session<'_> {
             );
         }
         let deadline = self.args.duration.map(|d| start + d);
-        while !self.stop.load(Ordering::Relaxed) && deadline.is_none_or(|d| WallClock::now() < d) {
+        while !self.stop.load(Ordering::Relaxed)
+            && self.out_failed.is_none()
+            && deadline.is_none_or(|d| WallClock::now() < d)
+        {
             let until: Instant = self.clock.now() + POLL;
             match blocking::run(
                 &mut *self.bus,
@@ -312,6 +319,10 @@ impl Session<'_> {
                 start.elapsed().as_secs_f64()
             );
         }
+        if let Some(e) = &self.out_failed {
+            let _ = writeln!(self.err, "error: cannot write to standard output: {e}");
+            return ExitCode::from(1);
+        }
         if failures.count > 0 {
             let _ = writeln!(
                 self.err,
@@ -334,7 +345,12 @@ impl Session<'_> {
             && !self.args.quiet
         {
             let t = start.elapsed().as_secs_f64();
-            let _ = writeln!(self.out, "{t:9.3} {line}");
+            if let Err(e) = writeln!(self.out, "{t:9.3} {line}").and_then(|()| self.out.flush()) {
+                // `| head` leaves: the simulator goes on without its log.
+                if e.kind() != io::ErrorKind::BrokenPipe && self.out_failed.is_none() {
+                    self.out_failed = Some(e);
+                }
+            }
         }
     }
 

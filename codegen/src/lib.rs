@@ -31,5 +31,6 @@ pub mod ir;
 pub mod profiles;
 pub mod read;
 pub mod table;
+pub mod text;
 
 pub use build::{Builder, Error, generate};

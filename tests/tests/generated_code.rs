@@ -37,6 +37,10 @@ const SEEDS: &[&str] = &[
 /// The hostile fixture, relative to the workspace root (also its display name).
 const HOSTILE: &str = "codegen/tests/fixtures/hostile.eds";
 
+/// A YAML table whose free text holds what an EDS cannot: bidirectional-text
+/// controls, NUL, ESC and other control characters, line breaks in names.
+const HOSTILE_YAML: &str = "codegen/tests/fixtures/hostile.yaml";
+
 /// A YAML table whose objects, values and error table are named like the core
 /// items generated code uses (`Option`, `Some`, `Result`, `From`, `core`):
 /// compiled with the rest, it shows those names cannot shadow them.
@@ -359,6 +363,10 @@ fn generated_code_compiles_under_clippy() {
         })
         .collect();
     inputs.push((HOSTILE.to_string(), workspace_root().join(HOSTILE)));
+    inputs.push((
+        HOSTILE_YAML.to_string(),
+        workspace_root().join(HOSTILE_YAML),
+    ));
     inputs.push((SHADOWING.to_string(), workspace_root().join(SHADOWING)));
     inputs.push((PINNED.to_string(), workspace_root().join(PINNED)));
     let own = inputs.len();
@@ -562,5 +570,45 @@ fn hostile_names_stay_in_string_literals() {
 
     let mut snapshots = Vec::new();
     push_snapshots(&mut snapshots, "hostile", HOSTILE, output);
+    check_snapshots(&snapshots);
+}
+
+/// The hostile YAML table generates code (compiled by
+/// `generated_code_compiles_under_clippy`, where rustc's deny-by-default
+/// `text_direction_codepoint_in_comment`/`_in_literal` lints would reject a
+/// raw bidi control) that holds no control character but line feeds and no
+/// bidi control at all: they are `\u{...}` escapes, in doc comments and
+/// literals alike; each text that had one gets a `gen::unsafe-text` warning.
+#[test]
+fn hostile_yaml_text_is_escaped() {
+    let path = workspace_root().join(HOSTILE_YAML);
+    let output = expect_generated(HOSTILE_YAML, &path);
+    for (n, line) in output.code.lines().enumerate() {
+        let bad = line.chars().find(|&c| eds2rust::text::is_hazard(c));
+        assert!(
+            bad.is_none(),
+            "generated line {} holds {:?}:\n{line}",
+            n + 1,
+            bad.unwrap_or_default()
+        );
+    }
+    for escaped in ["\\u{202E}", "\\u{2066}", "\\u{1B}", "\\u{0}"] {
+        assert!(
+            output.code.contains(escaped),
+            "{escaped} is not in the generated code: the fixture or the generator changed"
+        );
+    }
+    let unsafe_text = output
+        .warnings
+        .iter()
+        .filter(|d| d.code == "gen::unsafe-text")
+        .count();
+    assert!(
+        unsafe_text >= 20,
+        "expected a gen::unsafe-text warning per hostile text, got {unsafe_text}:\n{}",
+        render_warnings(&output.warnings)
+    );
+    let mut snapshots = Vec::new();
+    push_snapshots(&mut snapshots, "hostile_yaml", HOSTILE_YAML, output);
     check_snapshots(&snapshots);
 }

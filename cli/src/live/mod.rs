@@ -202,7 +202,8 @@ fn on_bus(
 ) -> ExitCode {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
-    let result = f(&|| args.open(), &mut out);
+    // The last line may sit in the buffer: a failed flush is a failed write.
+    let result = f(&|| args.open(), &mut out).and_then(|()| Ok(out.flush()?));
     drop(out);
     finish(result)
 }

@@ -226,12 +226,13 @@ impl Diagnostics {
                         d.code,
                         printable(&d.headline())
                     ));
+                    let file = printable(&d.file);
                     match d.location.line {
-                        Some(line) => out.push_str(&format!("  = in {}:{line}\n", d.file)),
-                        None => out.push_str(&format!("  = in {}\n", d.file)),
+                        Some(line) => out.push_str(&format!("  = in {file}:{line}\n")),
+                        None => out.push_str(&format!("  = in {file}\n")),
                     }
                     for note in &d.notes {
-                        out.push_str(&format!("  = {note}\n"));
+                        out.push_str(&format!("  = {}\n", printable(note)));
                     }
                     out.push('\n');
                     continue;
@@ -239,7 +240,7 @@ impl Diagnostics {
             };
             let mut buf = String::new();
             if term::emit_to_string(&mut buf, &config, &files, &cs).is_err() {
-                buf = format!("{d}\n");
+                buf = format!("{}\n", printable(&d.to_string()));
             }
             out.push_str(&buf);
         }
@@ -247,19 +248,10 @@ impl Diagnostics {
     }
 }
 
-/// The text with every control character other than line breaks and tabs
-/// replaced by `?` (one per byte, so byte offsets into it stay valid): a
-/// hostile input must not send escape sequences to the user's terminal.
+/// Terminal-safe text: [`crate::text::terminal`] (escape sequences and
+/// bidi controls as `?`, byte offsets kept).
 fn printable(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    for c in text.chars() {
-        if c.is_control() && !matches!(c, '\n' | '\r' | '\t') {
-            out.extend(std::iter::repeat_n('?', c.len_utf8()));
-        } else {
-            out.push(c);
-        }
-    }
-    out
+    crate::text::terminal(text).into_owned()
 }
 
 impl fmt::Display for Diagnostics {

@@ -141,11 +141,15 @@ pub const RULES: &[Rule] = &[
     ),
     rule(
         "gen::runtime-path",
-        "a runtime path that is not a Rust path",
+        "a runtime path that is not a crate or module path",
     ),
     rule(
         "gen::rust-name-collision",
         "a `rust_name:` pin equal to another name in its scope",
+    ),
+    rule(
+        "gen::unsafe-text",
+        "a name, description or unit with control or bidirectional-text characters",
     ),
     rule(
         "input::not-a-file",

@@ -70,7 +70,11 @@ pub(super) fn objects(cx: &mut Cx) {
                     path,
                     Some(Val::Text(old.name.clone())),
                     None,
-                    format!("{} `{}` removed", kind_name(old.kind), old.name),
+                    format!(
+                        "{} {} removed",
+                        kind_name(old.kind),
+                        crate::text::code_span(&old.name)
+                    ),
                 );
             }
             (None, Some(new)) => {
@@ -88,7 +92,11 @@ pub(super) fn objects(cx: &mut Cx) {
                     path,
                     None,
                     Some(Val::Text(new.name.clone())),
-                    format!("{} `{}` added", kind_name(new.kind), new.name),
+                    format!(
+                        "{} {} added",
+                        kind_name(new.kind),
+                        crate::text::code_span(&new.name)
+                    ),
                 );
             }
             (Some(old), Some(new)) => object(cx, old, new),
@@ -166,7 +174,7 @@ fn object(cx: &mut Cx, old: &Object, new: &Object) {
                     path,
                     Some(Val::Text(o.name.clone())),
                     None,
-                    format!("sub {sub} `{}` removed", o.name),
+                    format!("sub {sub} {} removed", crate::text::code_span(&o.name)),
                 );
             }
             (None, Some(n)) => {
@@ -179,7 +187,7 @@ fn object(cx: &mut Cx, old: &Object, new: &Object) {
                     path,
                     None,
                     Some(Val::Text(n.name.clone())),
-                    format!("sub {sub} `{}` added", n.name),
+                    format!("sub {sub} {} added", crate::text::code_span(&n.name)),
                 );
             }
             (Some(o), Some(n)) if !reshaped => entry(cx, old, o, n, object_renamed),
@@ -215,7 +223,11 @@ fn push_rename(
         new_path.clone(),
         Some(Val::Text(old_name.to_string())),
         Some(Val::Text(new_name.to_string())),
-        format!("name `{old_name}` → `{new_name}`{how}"),
+        format!(
+            "name {} → {}{how}",
+            crate::text::code_span(old_name),
+            crate::text::code_span(new_name)
+        ),
     );
 }
 

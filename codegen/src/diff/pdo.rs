@@ -224,7 +224,10 @@ fn labels(cx: &mut Cx) {
                 None,
                 o.description.clone().map(Val::Text),
                 n.description.clone().map(Val::Text),
-                format!("{name} label `{}`: description changed", n.name),
+                format!(
+                    "{name} label {}: description changed",
+                    crate::text::code_span(&n.name)
+                ),
             );
         }
     }

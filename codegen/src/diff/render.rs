@@ -5,6 +5,7 @@
 use std::fmt::Write;
 
 use super::{Change, Summary, Val};
+use crate::text::{code_span, terminal_line};
 
 /// Where a change is: `0x6041 sub 0`, `0x1A00`, or `device` for index 0.
 fn place(c: &Change) -> String {
@@ -28,14 +29,15 @@ pub fn summary(changes: &[Change]) -> String {
     )
 }
 
-/// One line per change, severity first, then the summary line.
+/// One line per change, severity first, then the summary line. Text from the
+/// inputs is terminal-safe ([`crate::text::terminal_line`]).
 pub fn text(changes: &[Change]) -> String {
     let mut out = String::new();
     for c in changes {
         let path = c
             .rust_path
             .as_deref()
-            .map(|p| format!(" `{p}`"))
+            .map(|p| format!(" {}", code_span(p)))
             .unwrap_or_default();
         let _ = writeln!(
             out,
@@ -43,7 +45,7 @@ pub fn text(changes: &[Change]) -> String {
             c.severity.as_str(),
             place(c),
             c.kind.as_str(),
-            c.message
+            terminal_line(&c.message)
         );
     }
     let _ = writeln!(out, "{}", summary(changes));
@@ -56,9 +58,9 @@ pub fn markdown(old: &str, new: &str, changes: &[Change]) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "### Object dictionary changes: `{}` → `{}`\n",
-        md(old),
-        md(new)
+        "### Object dictionary changes: {} → {}\n",
+        md(&code_span(old)),
+        md(&code_span(new))
     );
     if !changes.is_empty() {
         out.push_str("| severity | where | kind | Rust path | change |\n|---|---|---|---|---|\n");
@@ -71,7 +73,7 @@ pub fn markdown(old: &str, new: &str, changes: &[Change]) -> String {
             let path = c
                 .rust_path
                 .as_deref()
-                .map(|p| format!("`{}`", md(p)))
+                .map(|p| md(&code_span(p)))
                 .unwrap_or_default();
             let _ = writeln!(
                 out,
@@ -87,9 +89,10 @@ pub fn markdown(old: &str, new: &str, changes: &[Change]) -> String {
     out
 }
 
-/// Text that is safe inside a Markdown table cell.
+/// Text that is safe inside a Markdown table cell (names in it are code
+/// spans already, [`code_span`]): pipes escaped, one line, terminal-safe.
 fn md(text: &str) -> String {
-    text.replace('|', "\\|").replace(['\n', '\r'], " ")
+    terminal_line(&text.replace(['\n', '\r'], " ")).replace('|', "\\|")
 }
 
 /// One JSON object: `{"old", "new", "changes": [...]}`, pretty-printed with

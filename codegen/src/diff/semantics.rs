@@ -113,14 +113,19 @@ pub(super) fn entry(
                 Severity::Breaking,
                 Some(Val::Text(name.to_string())),
                 None,
-                format!("state pattern `{name}` removed"),
+                format!("state pattern {} removed", crate::text::code_span(name)),
             ),
             Some(q) if p.mask != q.mask || p.value != q.value || p.text != q.text => push(
                 Kind::PatternChanged,
                 Severity::Compatible,
                 Some(Val::Text(shape(p))),
                 Some(Val::Text(shape(q))),
-                format!("state pattern `{name}`: {} → {}", shape(p), shape(q)),
+                format!(
+                    "state pattern {}: {} → {}",
+                    crate::text::code_span(name),
+                    shape(p),
+                    shape(q)
+                ),
             ),
             Some(_) => {}
         }
@@ -134,7 +139,7 @@ pub(super) fn entry(
             Severity::Additive,
             None,
             Some(Val::Text(name.to_string())),
-            format!("state pattern `{name}` added"),
+            format!("state pattern {} added", crate::text::code_span(name)),
         );
     }
 }
@@ -160,21 +165,31 @@ fn value_table(push: &mut Push, what: &str, old: Option<&ValueTable>, new: Optio
                 Severity::Breaking,
                 Some(Val::Text(v.name.clone())),
                 None,
-                format!("{what}named value {at} `{}` removed", v.name),
+                format!(
+                    "{what}named value {at} {} removed",
+                    crate::text::code_span(&v.name)
+                ),
             ),
             Some(w) if w.name != v.name => push(
                 Kind::NamedValueChanged,
                 rename_severity(&v.name, &w.name, Case::UpperCamel),
                 Some(Val::Text(v.name.clone())),
                 Some(Val::Text(w.name.clone())),
-                format!("{what}named value {at}: `{}` → `{}`", v.name, w.name),
+                format!(
+                    "{what}named value {at}: {} → {}",
+                    crate::text::code_span(&v.name),
+                    crate::text::code_span(&w.name)
+                ),
             ),
             Some(w) if w.text != v.text => push(
                 Kind::NamedValueChanged,
                 Severity::Compatible,
                 text(&v.text),
                 text(&w.text),
-                format!("{what}named value {at} `{}`: text changed", w.name),
+                format!(
+                    "{what}named value {at} {}: text changed",
+                    crate::text::code_span(&w.name)
+                ),
             ),
             Some(_) => {}
         }
@@ -186,9 +201,9 @@ fn value_table(push: &mut Push, what: &str, old: Option<&ValueTable>, new: Optio
             None,
             Some(Val::Text(v.name.clone())),
             format!(
-                "{what}named value {} `{}` added",
+                "{what}named value {} {} added",
                 range(key.0, key.1),
-                v.name
+                crate::text::code_span(&v.name)
             ),
         );
     }
@@ -211,7 +226,11 @@ fn value_table(push: &mut Push, what: &str, old: Option<&ValueTable>, new: Optio
                 rename_severity(&ot.other, &nt.other, Case::UpperCamel),
                 Some(Val::Text(ot.other.clone())),
                 Some(Val::Text(nt.other.clone())),
-                format!("{what}fallback name `{}` → `{}`", ot.other, nt.other),
+                format!(
+                    "{what}fallback name {} → {}",
+                    crate::text::code_span(&ot.other),
+                    crate::text::code_span(&nt.other)
+                ),
             );
         }
     }
@@ -240,7 +259,11 @@ fn bit_fields(push: &mut Push, old: &[BitField], new: &[BitField]) {
                 Severity::Breaking,
                 Some(Val::Text(f.name.clone())),
                 None,
-                format!("bit field `{}` ({}) removed", f.name, bits(f)),
+                format!(
+                    "bit field {} ({}) removed",
+                    crate::text::code_span(&f.name),
+                    bits(f)
+                ),
             );
             continue;
         };
@@ -250,7 +273,12 @@ fn bit_fields(push: &mut Push, old: &[BitField], new: &[BitField]) {
                 Severity::Breaking,
                 Some(Val::Text(bits(f))),
                 Some(Val::Text(bits(g))),
-                format!("bit field `{}` moved: {} → {}", g.name, bits(f), bits(g)),
+                format!(
+                    "bit field {} moved: {} → {}",
+                    crate::text::code_span(&g.name),
+                    bits(f),
+                    bits(g)
+                ),
             );
         }
         if f.text != g.text || f.unit != g.unit || !same_real(f.scale, g.scale) || f.name != g.name
@@ -260,10 +288,13 @@ fn bit_fields(push: &mut Push, old: &[BitField], new: &[BitField]) {
                 Severity::Compatible,
                 Some(Val::Text(f.name.clone())),
                 Some(Val::Text(g.name.clone())),
-                format!("bit field `{}`: name, text, unit or scale changed", g.name),
+                format!(
+                    "bit field {}: name, text, unit or scale changed",
+                    crate::text::code_span(&g.name)
+                ),
             );
         }
-        let prefix = format!("bit field `{}`: ", g.name);
+        let prefix = format!("bit field {}: ", crate::text::code_span(&g.name));
         value_table(push, &prefix, f.values.as_ref(), g.values.as_ref());
     }
     for (key, g) in n.iter().filter(|(k, _)| !o.contains_key(*k)) {
@@ -273,7 +304,11 @@ fn bit_fields(push: &mut Push, old: &[BitField], new: &[BitField]) {
             Severity::Additive,
             None,
             Some(Val::Text(g.name.clone())),
-            format!("bit field `{}` ({}) added", g.name, bits(g)),
+            format!(
+                "bit field {} ({}) added",
+                crate::text::code_span(&g.name),
+                bits(g)
+            ),
         );
     }
 }
@@ -295,7 +330,11 @@ pub(super) fn error_tables(cx: &mut Cx) {
                 old_path,
                 Some(Val::Text(name.clone())),
                 None,
-                format!("error table `{name}` removed (codes: {})", t.codes.len()),
+                format!(
+                    "error table {} removed (codes: {})",
+                    crate::text::code_span(name),
+                    t.codes.len()
+                ),
             );
             continue;
         };
@@ -309,7 +348,12 @@ pub(super) fn error_tables(cx: &mut Cx) {
                 path.clone(),
                 Some(Val::Text(format!("{:?}", t.kind).to_lowercase())),
                 Some(Val::Text(format!("{:?}", u.kind).to_lowercase())),
-                format!("error table `{name}`: kind {:?} → {:?}", t.kind, u.kind),
+                format!(
+                    "error table {}: kind {:?} → {:?}",
+                    crate::text::code_span(name),
+                    t.kind,
+                    u.kind
+                ),
             );
         }
         if t.description != u.description {
@@ -321,7 +365,10 @@ pub(super) fn error_tables(cx: &mut Cx) {
                 path.clone(),
                 text(&t.description),
                 text(&u.description),
-                format!("error table `{name}`: description changed"),
+                format!(
+                    "error table {}: description changed",
+                    crate::text::code_span(name)
+                ),
             );
         }
         error_codes(cx, name, &path, t, u);
@@ -336,7 +383,11 @@ pub(super) fn error_tables(cx: &mut Cx) {
             path,
             None,
             Some(Val::Text(name.clone())),
-            format!("error table `{name}` added (codes: {})", u.codes.len()),
+            format!(
+                "error table {} added (codes: {})",
+                crate::text::code_span(name),
+                u.codes.len()
+            ),
         );
     }
 }
@@ -363,8 +414,9 @@ fn error_codes(
                 Some(Val::Int((*code).into())),
                 None,
                 format!(
-                    "error table `{table}`: code 0x{code:X} `{}` removed",
-                    c.name
+                    "error table {}: code 0x{code:X} {} removed",
+                    crate::text::code_span(table),
+                    crate::text::code_span(&c.name)
                 ),
             );
             continue;
@@ -379,8 +431,10 @@ fn error_codes(
                 Some(Val::Text(c.name.clone())),
                 Some(Val::Text(d.name.clone())),
                 format!(
-                    "error table `{table}`: code 0x{code:X} `{}` → `{}`",
-                    c.name, d.name
+                    "error table {}: code 0x{code:X} {} → {}",
+                    crate::text::code_span(table),
+                    crate::text::code_span(&c.name),
+                    crate::text::code_span(&d.name)
                 ),
             );
         }
@@ -398,8 +452,9 @@ fn error_codes(
                 text(&c.text),
                 text(&d.text),
                 format!(
-                    "error table `{table}`: code 0x{code:X} `{}`: text, reaction or remedy changed",
-                    d.name
+                    "error table {}: code 0x{code:X} {}: text, reaction or remedy changed",
+                    crate::text::code_span(table),
+                    crate::text::code_span(&d.name)
                 ),
             );
         }
@@ -413,7 +468,11 @@ fn error_codes(
             path.clone(),
             None,
             Some(Val::Int((*code).into())),
-            format!("error table `{table}`: code 0x{code:X} `{}` added", d.name),
+            format!(
+                "error table {}: code 0x{code:X} {} added",
+                crate::text::code_span(table),
+                crate::text::code_span(&d.name)
+            ),
         );
     }
 }

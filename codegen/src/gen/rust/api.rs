@@ -29,7 +29,9 @@ pub struct ApiListing {
 pub fn api_listing(device: &Device, options: &Options) -> Result<ApiListing, Diagnostics> {
     let output = generate(device, options)?;
     Ok(ApiListing {
-        text: listing(device),
+        // Units and names from the input: control and bidi characters as
+        // `\u{...}`, as in the generated code.
+        text: crate::text::code(&listing(device)).into_owned(),
         warnings: output.warnings,
     })
 }

@@ -9,8 +9,10 @@ use quote::quote;
 use super::naming;
 use crate::ir::{Access, Entry, Origin, Semantics};
 
-/// Source text made safe for Markdown: control characters become spaces and
-/// Markdown/HTML specials are backslash-escaped.
+/// Source text made safe for Markdown: line breaks and tabs become spaces and
+/// Markdown/HTML specials are backslash-escaped. Other control and bidi
+/// characters are left to [`crate::text::code`], which escapes them in the
+/// whole generated file.
 pub(crate) fn text(source: &str) -> String {
     let mut out = String::with_capacity(source.len());
     for c in source.chars() {
@@ -19,7 +21,8 @@ pub(crate) fn text(source: &str) -> String {
                 out.push('\\');
                 out.push(c);
             }
-            c if c.is_control() => out.push(' '),
+            // Line breaks would end the doc line; clippy warns on tabs.
+            '\n' | '\r' | '\t' => out.push(' '),
             c => out.push(c),
         }
     }
@@ -172,7 +175,7 @@ mod tests {
     #[test]
     fn escapes() {
         assert_eq!(text("a*b [x] <y> `z`"), "a\\*b \\[x\\] \\<y\\> \\`z\\`");
-        assert_eq!(text("line\u{1b}[31m"), "line \\[31m");
+        assert_eq!(text("line\u{1b}[31m\r\n\t"), "line\u{1b}\\[31m   ");
         assert_eq!(text("\"]; } */"), "\"\\]; } \\*/");
     }
 }

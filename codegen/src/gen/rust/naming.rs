@@ -150,9 +150,9 @@ pub(crate) fn alias_allowed(source: &str, ident: &str) -> bool {
         && source != ident
         && !source.starts_with(' ')
         && !source.ends_with(' ')
-        && !source
-            .chars()
-            .any(|c| c == '"' || c == '\'' || (c.is_whitespace() && c != ' ') || c.is_control())
+        && !source.chars().any(|c| {
+            c == '"' || c == '\'' || (c.is_whitespace() && c != ' ') || crate::text::is_hazard(c)
+        })
 }
 
 /// A handle to a requested name; resolved by [`Names::get`].
