@@ -330,6 +330,14 @@ pub fn download_file(
     let label = label(od.as_ref(), index, sub);
     let cannot_read =
         |e: std::io::Error| LiveError::Usage(format!("cannot read {}: {e}", a.file.display()));
+    // The transfer announces its size first: only a regular file has one
+    // (and opening a FIFO would wait for a writer).
+    if !std::fs::metadata(&a.file).map_err(cannot_read)?.is_file() {
+        return Err(LiveError::Usage(format!(
+            "{} is not a regular file; an SDO download sends a regular file, whose size it announces first",
+            a.file.display()
+        )));
+    }
     let mut file = std::fs::File::open(&a.file).map_err(cannot_read)?;
     let len = file.metadata().map_err(cannot_read)?.len();
     if u32::try_from(len).is_err() {

@@ -174,6 +174,10 @@ fn check_loaded(loaded: &Loaded, name: &str) {
         loaded.diagnostics.is_empty() || !rendered.is_empty(),
         "diagnostics render to nothing"
     );
+    assert!(
+        !rendered.chars().any(is_terminal_hazard),
+        "{name}: the diagnostics render a control or bidi character: {rendered:?}"
+    );
     if loaded.device.is_none() {
         assert!(
             loaded.diagnostics.has_errors(),
@@ -202,7 +206,18 @@ fn build(loaded: &Loaded) {
             if let Err(err) = syn::parse_file(&output.code) {
                 panic!("the generated code does not parse: {err}");
             }
-            let _ = output.warnings.render();
+            // rustc rejects bidirectional-text characters in comments and
+            // literals (deny-by-default lints): none may reach the file.
+            if let Some(c) = output.code.chars().find(|&c| eds2rust::text::is_bidi(c)) {
+                panic!("the generated code holds U+{:04X}", c as u32);
+            }
+            // Terminal text: every rendered diagnostic is free of control
+            // and bidirectional characters (but line breaks).
+            let rendered = output.warnings.render();
+            assert!(
+                !rendered.chars().any(is_terminal_hazard),
+                "a warning renders a control or bidi character: {rendered:?}"
+            );
             for line in cargo_lines(&loaded.files, &output.warnings, None) {
                 assert!(
                     !line.contains('\n'),
@@ -216,4 +231,11 @@ fn build(loaded: &Loaded) {
             let _ = error_lines(&errors);
         }
     }
+}
+
+/// A character no rendered diagnostic may hold: a control character (but
+/// line feeds, tabs and the carriage returns of CR LF source lines) or a
+/// bidirectional-text control.
+fn is_terminal_hazard(c: char) -> bool {
+    eds2rust::text::is_hazard(c) && c != '\r'
 }
