@@ -404,9 +404,12 @@ fn check(files: &[PathBuf], options: &Options) -> ExitCode {
 fn dump(path: &std::path::Path, node_id: Option<u8>, options: &Options) -> ExitCode {
     let loaded = read_device(path, options);
     let name = path.display().to_string();
-    let json =
-        eds2rust::dump::json::to_json(&name, loaded.device.as_ref(), &loaded.diagnostics, node_id);
-    let text = serde_json::to_string_pretty(&json).expect("a serde_json::Value always serialises");
+    let text = eds2rust::dump::json::to_json_pretty(
+        &name,
+        loaded.device.as_ref(),
+        &loaded.diagnostics,
+        node_id,
+    );
     // A closed pipe (`| head`) is not an error of ours.
     let _ = writeln!(std::io::stdout().lock(), "{text}");
     if loaded.diagnostics.has_errors() {

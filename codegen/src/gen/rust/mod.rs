@@ -24,6 +24,7 @@ mod docs;
 mod entries;
 mod enums;
 mod errors;
+mod format;
 pub(crate) mod naming;
 mod objects;
 pub(crate) mod od_plan;
@@ -114,17 +115,15 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
     let object_table = objects::emit(device, &rt);
     let identity = identity_items(device);
 
-    let mut file = identity;
-    file.extend(quote! {
+    let od_shell = quote! {
         #[doc = " The object dictionary: one zero-sized type per entry (see the runtime's `od::Entry`)."]
         pub mod od {
             #use_runtime
-            #od_items
-            #object_table
         }
-    });
+    };
+    let mut errors = None;
     if !device.error_tables.is_empty() {
-        file.extend(quote! {
+        errors = Some(quote! {
             #[doc = " Device error tables as enums."]
             pub mod errors {
                 #use_runtime
@@ -132,8 +131,9 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
             }
         });
     }
+    let mut pdo = None;
     if !pdo_items.is_empty() {
-        file.extend(quote! {
+        pdo = Some(quote! {
             #[doc = " Default PDOs: fixed layouts with `encode`/`decode`."]
             pub mod pdo {
                 #use_runtime
@@ -141,8 +141,18 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
             }
         });
     }
-    let code = match syn::parse2::<syn::File>(file) {
-        Ok(parsed) => prettyplease::unparse(&parsed),
+    // A part at a time: the memory of a syntax tree of the whole file is
+    // many times that of its tokens (format.rs).
+    let formatted = (|| -> syn::Result<String> {
+        let mut code = format::file(identity)?;
+        format::module(&mut code, od_shell, od_items, Some(object_table))?;
+        for module in errors.into_iter().chain(pdo) {
+            code.push_str(&format::file(module)?);
+        }
+        Ok(code)
+    })();
+    let code = match formatted {
+        Ok(code) => code,
         Err(err) => {
             diags.push(Diagnostic {
                 severity: Severity::Error,

@@ -12,8 +12,9 @@ use crate::ir::{Access, DataType, Device, Literal, ObjectKind, Value};
 /// The `OBJECTS` constant, sorted by index and subindex: one
 /// `ObjectInfo::new(..)` per entry, so that each entry is a line or two
 /// (the variants of the runtime's enums imported into the constant's
-/// block).
-pub(crate) fn emit(device: &Device, rt: &TokenStream) -> TokenStream {
+/// block). The rows come apart from the rest so that a table of a million
+/// rows is formatted a part at a time (`format.rs`).
+pub(crate) fn emit(device: &Device, rt: &TokenStream) -> Table {
     let mut rows = Vec::new();
     let mut used = Used::default();
     for object in device.objects.values() {
@@ -53,13 +54,6 @@ pub(crate) fn emit(device: &Device, rt: &TokenStream) -> TokenStream {
             rows.push(row);
         }
     }
-    let doc = " Every entry as plain data (index, subindex, name, type, access, default, limits), sorted by index and subindex.";
-    if rows.is_empty() {
-        return quote! {
-            #[doc = #doc]
-            pub const OBJECTS: &[#rt::od::ObjectInfo] = &[];
-        };
-    }
     // Only what the rows use is imported (an unused import warns).
     let option: Vec<Ident> = [("None", used.none), ("Some", used.some)]
         .into_iter()
@@ -75,13 +69,44 @@ pub(crate) fn emit(device: &Device, rt: &TokenStream) -> TokenStream {
         od.push(quote!(Number::*));
     }
     od.push(quote!(ObjectInfo as O));
-    quote! {
-        #[doc = #doc]
-        pub const OBJECTS: &[#rt::od::ObjectInfo] = {
-            #option
-            use #rt::od::{#(#od),*};
-            &[#(#rows,)*]
-        };
+    Table {
+        rt: rt.clone(),
+        option,
+        od,
+        rows,
+    }
+}
+
+/// The parts of `OBJECTS`.
+pub(crate) struct Table {
+    rt: TokenStream,
+    option: Option<TokenStream>,
+    od: Vec<TokenStream>,
+    /// One `O::new(..)` expression per entry.
+    pub rows: Vec<TokenStream>,
+}
+
+impl Table {
+    /// The constant with `rows` as its elements: with [`Table::rows`], the
+    /// whole constant.
+    pub(crate) fn item(&self, rows: &[TokenStream]) -> TokenStream {
+        let doc = " Every entry as plain data (index, subindex, name, type, access, default, limits), sorted by index and subindex.";
+        let rt = &self.rt;
+        if rows.is_empty() {
+            return quote! {
+                #[doc = #doc]
+                pub const OBJECTS: &[#rt::od::ObjectInfo] = &[];
+            };
+        }
+        let (option, od) = (&self.option, &self.od);
+        quote! {
+            #[doc = #doc]
+            pub const OBJECTS: &[#rt::od::ObjectInfo] = {
+                #option
+                use #rt::od::{#(#od),*};
+                &[#(#rows,)*]
+            };
+        }
     }
 }
 
