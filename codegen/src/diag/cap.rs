@@ -125,3 +125,84 @@ pub(super) fn summarised(d: &Diagnostic) -> Option<usize> {
     }
     d.message.split(' ').next()?.parse().ok()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diag::{Diagnostics, Level, Levels};
+
+    fn diag(code: &'static str, file: &str, line: u32, severity: Severity) -> Diagnostic {
+        Diagnostic {
+            severity,
+            code,
+            file: file.into(),
+            location: Location {
+                line: Some(line),
+                ..Location::default()
+            },
+            message: format!("problem on line {line}"),
+            notes: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn the_first_of_each_rule_and_file_are_kept_and_the_rest_counted() {
+        let mut d = Diagnostics::new();
+        for line in 1..=250 {
+            d.push(diag("eds::duplicate-key", "a.eds", line, Severity::Warning));
+            if line <= 3 {
+                d.push(diag("eds::bad-value", "a.eds", line, Severity::Warning));
+            }
+            if line <= 120 {
+                d.push(diag("eds::duplicate-key", "b.eds", line, Severity::Warning));
+            }
+        }
+        // One error among the left-out warnings makes the summary an error.
+        d.push(diag("eds::duplicate-key", "a.eds", 251, Severity::Error));
+        d.sort();
+        assert_eq!(d.len(), CAP + 1 + 3 + CAP + 1);
+        let summaries: Vec<(&str, Option<u32>, Severity, usize)> = d
+            .iter()
+            .filter_map(|x| Some((x.file.as_str(), x.location.line, x.severity, summarised(x)?)))
+            .collect();
+        assert_eq!(
+            summaries,
+            [
+                ("a.eds", Some(101), Severity::Error, 151),
+                ("b.eds", Some(101), Severity::Warning, 20),
+            ]
+        );
+        // A second flush adds nothing; more left out make a new summary.
+        d.flush_caps();
+        assert_eq!(d.len(), 2 * CAP + 5);
+        d.push(diag("eds::duplicate-key", "b.eds", 500, Severity::Warning));
+        d.sort();
+        assert_eq!(d.len(), 2 * CAP + 6);
+    }
+
+    #[test]
+    fn an_allowed_rule_counts_every_left_out_warning() {
+        let mut d = Diagnostics::new();
+        for line in 1..=130 {
+            d.push(diag("eds::unknown-section", "a.eds", line, Severity::Warning));
+        }
+        let mut levels = Levels::new();
+        levels.set("eds::unknown-section", Level::Allow, "test");
+        d.apply_levels(&levels, false);
+        assert!(d.is_empty());
+        assert_eq!(d.allowed_count(), 130);
+    }
+
+    #[test]
+    fn merged_runs_keep_their_summaries() {
+        let mut a = Diagnostics::new();
+        let mut b = Diagnostics::new();
+        for line in 1..=110 {
+            b.push(diag("eds::limits", "b.eds", line, Severity::Warning));
+        }
+        a.push(diag("eds::limits", "a.eds", 1, Severity::Warning));
+        a.extend(b);
+        assert_eq!(a.len(), 1 + CAP + 1);
+        assert_eq!(a.iter().filter_map(summarised).collect::<Vec<_>>(), [10]);
+    }
+}

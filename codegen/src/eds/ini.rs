@@ -396,6 +396,35 @@ mod tests {
     }
 
     #[test]
+    fn duplicates_in_a_large_section_are_found_by_the_index() {
+        // Past SCAN_LIMIT keys the section is searched by its index: the
+        // same rules (any case, later value wins, the warning names the line
+        // of the value it replaces).
+        let mut text = String::from("[MandatoryObjects]\n");
+        for i in 0..100 {
+            text.push_str(&format!("Key{i}={i}\n"));
+        }
+        text.push_str("KEY7=late\nkey99=later\nKey7=last\n");
+        let (doc, d) = doc(&text);
+        let s = doc.section("mandatoryobjects").unwrap();
+        assert_eq!(s.properties.len(), 100);
+        assert_eq!(s.get("key7").unwrap().value, "last");
+        assert_eq!(s.get("KEY99").unwrap().value, "later");
+        assert_eq!(s.get("Key0").unwrap().line, 2);
+        assert!(s.get("Key100").is_none());
+        let lines: Vec<(Option<u32>, &str)> =
+            d.iter().map(|d| (d.location.line, d.message.as_str())).collect();
+        assert_eq!(
+            lines,
+            [
+                (Some(102), "key repeated (first at line 9); this later value wins"),
+                (Some(103), "key repeated (first at line 101); this later value wins"),
+                (Some(104), "key repeated (first at line 102); this later value wins"),
+            ]
+        );
+    }
+
+    #[test]
     fn latin1_fallback() {
         let mut d = Diagnostics::new();
         let text = decode("t.eds", b"[Comments]\nLine1=Gr\xf6\xdfe\n", &mut d);

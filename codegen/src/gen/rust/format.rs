@@ -104,3 +104,37 @@ fn objects(mut table: Table) -> syn::Result<String> {
     text.push_str(&shell[tail_start..]);
     Ok(text)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A device whose `OBJECTS` has rows of every length around the line
+    /// width (some fit on one line, some break), defaults and limits.
+    fn device() -> crate::ir::Device {
+        let mut eds = String::from("[DeviceInfo]\nVendorName=v\n");
+        for i in 0..700u32 {
+            let name = "n".repeat((i % 97) as usize + 1);
+            eds.push_str(&format!(
+                "[{:04X}]\nParameterName={name}\nObjectType=0x7\nDataType=0x0007\nAccessType=rw\n",
+                0x2000 + i
+            ));
+            if i % 3 == 0 {
+                eds.push_str(&format!("DefaultValue={i}\nLowLimit=0\nHighLimit=100000\n"));
+            }
+        }
+        eds.push_str("[3000]\nParameterName=Array\nObjectType=0x8\nDataType=0x0007\nAccessType=ro\nCompactSubObj=254\n");
+        let loaded = crate::eds::read_bytes("t.eds", eds.as_bytes(), &Default::default());
+        loaded.device.expect("a device")
+    }
+
+    #[test]
+    fn objects_in_chunks_is_the_table_formatted_whole() {
+        let device = device();
+        let table = super::super::objects::emit(&device, &quote!(rt));
+        assert!(table.rows.len() > 3 * CHUNK);
+        let whole = in_module(table.item(&table.rows)).unwrap();
+        assert!(whole.lines().any(|l| l.trim_start().starts_with(".with_default")));
+        assert_eq!(objects(table).unwrap(), whole);
+    }
+}
