@@ -120,7 +120,11 @@ fn summary(
 /// How many diagnostics the summary `d` stands for (`None`: not a summary).
 pub(super) fn summarised(d: &Diagnostic) -> Option<usize> {
     let l = &d.location;
-    if l.span.is_some() || l.section.is_some() || l.key.is_some() || !d.message.contains(SUMMARY_TAIL) {
+    if l.span.is_some()
+        || l.section.is_some()
+        || l.key.is_some()
+        || !d.message.contains(SUMMARY_TAIL)
+    {
         return None;
     }
     d.message.split(' ').next()?.parse().ok()
@@ -184,7 +188,12 @@ mod tests {
     fn an_allowed_rule_counts_every_left_out_warning() {
         let mut d = Diagnostics::new();
         for line in 1..=130 {
-            d.push(diag("eds::unknown-section", "a.eds", line, Severity::Warning));
+            d.push(diag(
+                "eds::unknown-section",
+                "a.eds",
+                line,
+                Severity::Warning,
+            ));
         }
         let mut levels = Levels::new();
         levels.set("eds::unknown-section", Level::Allow, "test");

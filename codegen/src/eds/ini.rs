@@ -412,14 +412,25 @@ mod tests {
         assert_eq!(s.get("KEY99").unwrap().value, "later");
         assert_eq!(s.get("Key0").unwrap().line, 2);
         assert!(s.get("Key100").is_none());
-        let lines: Vec<(Option<u32>, &str)> =
-            d.iter().map(|d| (d.location.line, d.message.as_str())).collect();
+        let lines: Vec<(Option<u32>, &str)> = d
+            .iter()
+            .map(|d| (d.location.line, d.message.as_str()))
+            .collect();
         assert_eq!(
             lines,
             [
-                (Some(102), "key repeated (first at line 9); this later value wins"),
-                (Some(103), "key repeated (first at line 101); this later value wins"),
-                (Some(104), "key repeated (first at line 102); this later value wins"),
+                (
+                    Some(102),
+                    "key repeated (first at line 9); this later value wins"
+                ),
+                (
+                    Some(103),
+                    "key repeated (first at line 101); this later value wins"
+                ),
+                (
+                    Some(104),
+                    "key repeated (first at line 102); this later value wins"
+                ),
             ]
         );
     }

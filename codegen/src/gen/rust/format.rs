@@ -25,7 +25,7 @@ pub(super) fn file(tokens: TokenStream) -> syn::Result<String> {
 }
 
 /// The formatted items as they stand directly inside a top-level module.
-fn in_module(items: TokenStream) -> syn::Result<String> {
+pub(super) fn in_module(items: TokenStream) -> syn::Result<String> {
     let text = file(quote!(mod m { #items }))?;
     Ok(text
         .strip_prefix("mod m {\n")
@@ -35,12 +35,12 @@ fn in_module(items: TokenStream) -> syn::Result<String> {
 }
 
 /// Appends to `out` the top-level module `shell` (its attributes and the
-/// items it starts with) with each of `groups` (items) and then `table`
-/// added at its end.
+/// items it starts with) with `body` (items formatted by [`in_module`])
+/// and then `table` added at its end.
 pub(super) fn module(
     out: &mut String,
     shell: TokenStream,
-    groups: Vec<TokenStream>,
+    body: &str,
     table: Option<Table>,
 ) -> syn::Result<()> {
     let head = file(shell)?;
@@ -51,9 +51,7 @@ pub(super) fn module(
         ));
     };
     out.push_str(head);
-    for group in groups {
-        out.push_str(&in_module(group)?);
-    }
+    out.push_str(body);
     if let Some(table) = table {
         out.push_str(&objects(table)?);
     }
@@ -62,9 +60,13 @@ pub(super) fn module(
 }
 
 /// The formatted `OBJECTS` constant inside a top-level module.
-fn objects(mut table: Table) -> syn::Result<String> {
-    if table.rows.len() <= CHUNK {
-        return in_module(table.item(&table.rows));
+fn objects(table: Table) -> syn::Result<String> {
+    let whole = || {
+        let rows: Vec<TokenStream> = table.rows().collect();
+        in_module(table.item(&rows))
+    };
+    if table.len <= CHUNK {
+        return whole();
     }
     // So many rows never fit on one line: every row starts a line, as next
     // to a row longer than any line. The constant is formatted around such
@@ -83,22 +85,19 @@ fn objects(mut table: Table) -> syn::Result<String> {
     };
     let shell = in_module(table.item(std::slice::from_ref(&long)))?;
     let Some((head_end, tail_start)) = split(&shell) else {
-        return in_module(table.item(&table.rows));
+        return whole();
     };
     let head = &shell[..head_end];
     let mut text = head.to_string();
-    let rows = std::mem::take(&mut table.rows);
-    for chunk in rows.chunks(CHUNK) {
-        let mut chunk = chunk.to_vec();
+    let mut rows = table.rows().peekable();
+    while rows.peek().is_some() {
+        let mut chunk: Vec<TokenStream> = rows.by_ref().take(CHUNK).collect();
         chunk.push(long.clone());
         let part = in_module(table.item(&chunk))?;
         match split(&part) {
             Some((end, _)) if part.starts_with(head) => text.push_str(&part[head.len()..end]),
             // Not the layout this relies on: format the table whole.
-            _ => {
-                table.rows = rows;
-                return in_module(table.item(&table.rows));
-            }
+            _ => return whole(),
         }
     }
     text.push_str(&shell[tail_start..]);
@@ -132,9 +131,14 @@ mod tests {
     fn objects_in_chunks_is_the_table_formatted_whole() {
         let device = device();
         let table = super::super::objects::emit(&device, &quote!(rt));
-        assert!(table.rows.len() > 3 * CHUNK);
-        let whole = in_module(table.item(&table.rows)).unwrap();
-        assert!(whole.lines().any(|l| l.trim_start().starts_with(".with_default")));
+        assert!(table.len > 3 * CHUNK);
+        let rows: Vec<TokenStream> = table.rows().collect();
+        let whole = in_module(table.item(&rows)).unwrap();
+        assert!(
+            whole
+                .lines()
+                .any(|l| l.trim_start().starts_with(".with_default"))
+        );
         assert_eq!(objects(table).unwrap(), whole);
     }
 }

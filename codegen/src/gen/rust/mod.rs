@@ -109,7 +109,18 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
         errors: &error_plans,
         diags: &mut diags,
     };
-    let (od_items, infos) = entries::emit(&mut cx);
+    // Each object's items are formatted as they are made and their tokens
+    // dropped: the tokens of a whole device take many times its text.
+    let mut od_body = String::new();
+    let mut format_error = None;
+    let infos = entries::emit(&mut cx, &mut |items| {
+        if format_error.is_none() {
+            match format::in_module(items) {
+                Ok(text) => od_body.push_str(&text),
+                Err(err) => format_error = Some(err),
+            }
+        }
+    });
     let error_items = errors::emit(device, &error_plans, &rt, &mut diags);
     let pdo_items = pdo::emit(device, &infos, &rt, &mut diags);
     let object_table = objects::emit(device, &rt);
@@ -141,11 +152,14 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
             }
         });
     }
-    // A part at a time: the memory of a syntax tree of the whole file is
-    // many times that of its tokens (format.rs).
+    // A part at a time: the syntax tree of a whole file takes many times
+    // the memory of its tokens (format.rs).
     let formatted = (|| -> syn::Result<String> {
+        if let Some(err) = format_error {
+            return Err(err);
+        }
         let mut code = format::file(identity)?;
-        format::module(&mut code, od_shell, od_items, Some(object_table))?;
+        format::module(&mut code, od_shell, &od_body, Some(object_table))?;
         for module in errors.into_iter().chain(pdo) {
             code.push_str(&format::file(module)?);
         }
