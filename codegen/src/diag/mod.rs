@@ -95,8 +95,9 @@ pub struct Diagnostics {
     sources: Vec<(String, String)>,
     /// Warnings dropped because their rule is allowed.
     allowed: usize,
-    /// Diagnostics kept and left out per rule and file ([`CAP`]).
-    caps: cap::Caps,
+    /// Diagnostics kept and left out per rule and file ([`CAP`]); boxed to
+    /// keep `Diagnostics` (in every error type) small.
+    caps: Box<cap::Caps>,
 }
 
 impl Diagnostics {
@@ -149,7 +150,7 @@ impl Diagnostics {
         }
         self.items.extend(other.items);
         self.allowed += other.allowed;
-        self.caps.absorb(other.caps);
+        self.caps.absorb(*other.caps);
     }
 
     pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
