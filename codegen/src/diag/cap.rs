@@ -109,7 +109,12 @@ fn summary(
             ..Location::default()
         },
         message: format!(
-            "{omitted} more `{code}` {what} of this file, from this line on, {SUMMARY_TAIL} {CAP} of each rule are shown"
+            "{omitted} more `{code}` {what} of this file{} {SUMMARY_TAIL} {CAP} of each rule are shown",
+            if line.is_some() {
+                ", from this line on,"
+            } else {
+                ""
+            }
         ),
         notes: vec![format!(
             "fix the ones shown and read the file again to see the rest, or drop the rule with `allow` if it is expected"
