@@ -435,9 +435,12 @@ fn dump(path: &std::path::Path, node_id: Option<u8>, options: &Options) -> ExitC
         loaded.diagnostics.extend(errors);
     }
     let name = path.display().to_string();
-    let json =
-        eds2rust::dump::json::to_json(&name, loaded.device.as_ref(), &loaded.diagnostics, node_id);
-    let text = serde_json::to_string_pretty(&json).expect("a serde_json::Value always serialises");
+    let text = eds2rust::dump::json::to_json_pretty(
+        &name,
+        loaded.device.as_ref(),
+        &loaded.diagnostics,
+        node_id,
+    );
     if let Err(code) = print(&format!("{text}\n")) {
         return code;
     }

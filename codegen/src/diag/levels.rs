@@ -94,10 +94,15 @@ impl Diagnostics {
     /// warnings, and with `strict` every remaining warning, become errors.
     /// Errors are never changed.
     pub fn apply_levels(&mut self, levels: &Levels, strict: bool) {
-        let before = self.items.len();
-        self.items
-            .retain(|d| d.severity == Severity::Error || levels.get(d.code) != Some(Level::Allow));
-        self.allowed += before - self.items.len();
+        self.flush_caps();
+        let mut dropped = 0;
+        self.items.retain(|d| {
+            let keep = d.severity == Severity::Error || levels.get(d.code) != Some(Level::Allow);
+            // A summary of left-out warnings counts for each of them.
+            dropped += usize::from(!keep) * super::cap::summarised(d).unwrap_or(1);
+            keep
+        });
+        self.allowed += dropped;
         for d in &mut self.items {
             if d.severity != Severity::Warning {
                 continue;

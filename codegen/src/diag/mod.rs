@@ -2,8 +2,11 @@
 //! key, rendered with the source line by codespan-reporting; the rules they
 //! belong to ([`rules`]) and the levels a user sets for them ([`Levels`]).
 
+mod cap;
 mod levels;
 pub mod rules;
+
+pub use cap::CAP;
 
 pub use levels::{Level, Levels};
 
@@ -92,6 +95,9 @@ pub struct Diagnostics {
     sources: Vec<(String, String)>,
     /// Warnings dropped because their rule is allowed.
     allowed: usize,
+    /// Diagnostics kept and left out per rule and file ([`CAP`]); boxed to
+    /// keep `Diagnostics` (in every error type) small.
+    caps: Box<cap::Caps>,
 }
 
 impl Diagnostics {
@@ -106,8 +112,21 @@ impl Diagnostics {
         }
     }
 
+    /// Adds a diagnostic, unless [`CAP`] diagnostics of its rule in its
+    /// file are kept already: then it is only counted, and a summary saying
+    /// how many were left out is added by [`Diagnostics::flush_caps`] (which
+    /// the sorting, merging and level methods call, so every reader's
+    /// output has its summaries).
     pub fn push(&mut self, diagnostic: Diagnostic) {
-        self.items.push(diagnostic);
+        if self.caps.admit(&diagnostic) {
+            self.items.push(diagnostic);
+        }
+    }
+
+    /// Adds one summary diagnostic per rule and file for the diagnostics
+    /// [`push`](Self::push) left out since the last call.
+    pub fn flush_caps(&mut self) {
+        self.items.extend(self.caps.take_summaries());
     }
 
     /// Keeps only the diagnostics for which `keep` is true.
@@ -122,12 +141,16 @@ impl Diagnostics {
         }
     }
 
-    pub fn extend(&mut self, other: Diagnostics) {
+    /// Merges the diagnostics of another run (already capped there) into this one.
+    pub fn extend(&mut self, mut other: Diagnostics) {
+        self.flush_caps();
+        other.flush_caps();
         for (file, text) in &other.sources {
             self.add_source(file, text);
         }
         self.items.extend(other.items);
         self.allowed += other.allowed;
+        self.caps.absorb(*other.caps);
     }
 
     pub fn iter(&self) -> impl Iterator<Item = &Diagnostic> {
@@ -165,6 +188,7 @@ impl Diagnostics {
 
     /// Turns every warning into an error (`--strict`).
     pub fn make_strict(&mut self) {
+        self.flush_caps();
         for d in &mut self.items {
             d.severity = Severity::Error;
         }
@@ -172,11 +196,13 @@ impl Diagnostics {
 
     /// The errors first, then the warnings, each in their order before.
     pub fn errors_first(&mut self) {
+        self.flush_caps();
         self.items.sort_by_key(|d| d.severity != Severity::Error);
     }
 
     /// Sorts by file, then line, keeping the order of diagnostics on one line.
     pub fn sort(&mut self) {
+        self.flush_caps();
         self.items
             .sort_by(|a, b| (&a.file, a.location.line).cmp(&(&b.file, b.location.line)));
     }

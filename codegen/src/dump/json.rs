@@ -2,6 +2,7 @@
 //! identity, every value-carrying entry sorted by index then subindex, and the
 //! diagnostics. Type definitions (DEFTYPE/DEFSTRUCT) are not entries.
 
+use serde::ser::{Serialize, SerializeMap, SerializeSeq, Serializer};
 use serde_json::{Map, Value as Json, json};
 
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
@@ -14,34 +15,111 @@ pub fn to_json(
     diagnostics: &Diagnostics,
     node_id: Option<u8>,
 ) -> Json {
-    let identity = device.map(|d| &d.identity);
-    let device_json = json!({
-        "vendor_name": identity.and_then(|i| i.vendor_name.clone()),
-        "vendor_number": identity.and_then(|i| i.vendor_number),
-        "product_name": identity.and_then(|i| i.product_name.clone()),
-        "product_number": identity.and_then(|i| i.product_number),
-        "revision_number": identity.and_then(|i| i.revision_number),
-    });
-    let mut entries = Vec::new();
-    if let Some(device) = device {
-        for object in device.objects.values() {
+    let entries: Vec<Json> = entries(device, node_id).collect();
+    json!({
+        "file": file,
+        "device": device_json(device),
+        "entries": entries,
+        "diagnostics": diagnostics_json(diagnostics),
+    })
+}
+
+/// The text of [`to_json`] pretty-printed (`serde_json::to_string_pretty`),
+/// written an entry at a time: the memory is that of the text, not of a
+/// JSON tree of the whole device (several times larger).
+pub fn to_json_pretty(
+    file: &str,
+    device: Option<&Device>,
+    diagnostics: &Diagnostics,
+    node_id: Option<u8>,
+) -> String {
+    let document = Document {
+        file,
+        device,
+        diagnostics,
+        node_id,
+    };
+    let bytes = serde_json::to_vec_pretty(&document).unwrap_or_default();
+    String::from_utf8(bytes).unwrap_or_default()
+}
+
+/// [`to_json`] as something to serialize without building it.
+struct Document<'a> {
+    file: &'a str,
+    device: Option<&'a Device>,
+    diagnostics: &'a Diagnostics,
+    node_id: Option<u8>,
+}
+
+/// The entries as a sequence serialized one at a time.
+struct Entries<'a>(Option<&'a Device>, Option<u8>);
+
+impl Serialize for Entries<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        let mut seq = serializer.serialize_seq(None)?;
+        for entry in entries(self.0, self.1) {
+            seq.serialize_element(&entry)?;
+        }
+        seq.end()
+    }
+}
+
+impl Serialize for Document<'_> {
+    fn serialize<S: Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        // The keys in the order a JSON object of `to_json` has them.
+        let order = json!({"file": 0, "device": 0, "entries": 0, "diagnostics": 0});
+        let mut map = serializer.serialize_map(Some(4))?;
+        for key in order.as_object().into_iter().flat_map(|o| o.keys()) {
+            match key.as_str() {
+                "file" => map.serialize_entry(key, self.file)?,
+                "device" => map.serialize_entry(key, &device_json(self.device))?,
+                "entries" => map.serialize_entry(key, &Entries(self.device, self.node_id))?,
+                _ => map.serialize_entry(key, &diagnostics_json(self.diagnostics))?,
+            }
+        }
+        map.end()
+    }
+}
+
+fn diagnostics_json(diagnostics: &Diagnostics) -> Vec<Json> {
+    diagnostics
+        .iter()
+        .map(|d| json!({"severity": d.severity.as_str(), "line": d.location.line, "message": d.headline()}))
+        .collect()
+}
+
+/// Every value-carrying entry, as JSON, in index and subindex order.
+fn entries(device: Option<&Device>, node_id: Option<u8>) -> impl Iterator<Item = Json> + '_ {
+    device
+        .into_iter()
+        .flat_map(|device| device.objects.values())
+        .filter_map(|object| {
             let object_type = match object.kind {
                 ObjectKind::Var => "VAR",
                 ObjectKind::Domain => "DOMAIN",
                 ObjectKind::Array => "ARRAY",
                 ObjectKind::Record => "RECORD",
-                ObjectKind::DefType | ObjectKind::DefStruct => continue,
+                ObjectKind::DefType | ObjectKind::DefStruct => return None,
             };
-            for entry in object.entries.values() {
-                entries.push(entry_json(object, object_type, entry, node_id));
-            }
-        }
-    }
-    let diagnostics: Vec<Json> = diagnostics
-        .iter()
-        .map(|d| json!({"severity": d.severity.as_str(), "line": d.location.line, "message": d.headline()}))
-        .collect();
-    json!({"file": file, "device": device_json, "entries": entries, "diagnostics": diagnostics})
+            Some((object, object_type))
+        })
+        .flat_map(move |(object, object_type)| {
+            object
+                .entries
+                .values()
+                .map(move |entry| entry_json(object, object_type, entry, node_id))
+        })
+}
+
+fn device_json(device: Option<&Device>) -> Json {
+    let identity = device.map(|d| &d.identity);
+    json!({
+        "vendor_name": identity.and_then(|i| i.vendor_name.clone()),
+        "vendor_number": identity.and_then(|i| i.vendor_number),
+        "product_name": identity.and_then(|i| i.product_name.clone()),
+        "product_number": identity.and_then(|i| i.product_number),
+        "revision_number": identity.and_then(|i| i.revision_number),
+    })
 }
 
 /// An error for every value of `device` that leaves its type once

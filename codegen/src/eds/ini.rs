@@ -41,14 +41,59 @@ pub struct Section<'a> {
     pub line: u32,
     pub header_span: Range<usize>,
     pub properties: Vec<Property<'a>>,
+    /// Lowercase key → position in `properties`, once the section has more
+    /// than [`SCAN_LIMIT`] keys: lookups stay constant time in sections of
+    /// any size (a list of 200,000 objects), and small sections (every
+    /// object section) pay no allocation per key.
+    index: Option<HashMap<String, usize>>,
 }
 
+/// Sections with at most this many keys are searched by a scan.
+const SCAN_LIMIT: usize = 16;
+
 impl<'a> Section<'a> {
+    fn new(name: &'a str, line: u32, header_span: Range<usize>) -> Section<'a> {
+        Section {
+            name,
+            line,
+            header_span,
+            properties: Vec::new(),
+            index: None,
+        }
+    }
+
+    /// The position in `properties` of the key `key`, without regard to case.
+    fn position(&self, key: &str) -> Option<usize> {
+        match &self.index {
+            Some(index) => index.get(&key.to_ascii_lowercase()).copied(),
+            None => self
+                .properties
+                .iter()
+                .position(|p| p.key.eq_ignore_ascii_case(key)),
+        }
+    }
+
+    /// Adds a property whose key is not in the section yet.
+    fn push(&mut self, property: Property<'a>) {
+        let position = self.properties.len();
+        if let Some(index) = &mut self.index {
+            index.insert(property.key.to_ascii_lowercase(), position);
+        } else if position == SCAN_LIMIT {
+            let index = self
+                .properties
+                .iter()
+                .chain([&property])
+                .enumerate()
+                .map(|(i, p)| (p.key.to_ascii_lowercase(), i))
+                .collect();
+            self.index = Some(index);
+        }
+        self.properties.push(property);
+    }
+
     /// The property whose key matches `key` without regard to case.
     pub fn get(&self, key: &str) -> Option<&Property<'a>> {
-        self.properties
-            .iter()
-            .find(|p| p.key.eq_ignore_ascii_case(key))
+        self.position(key).map(|i| &self.properties[i])
     }
 }
 
@@ -273,12 +318,7 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
             } else {
                 by_name.insert(key, sections.len());
                 current = Some(sections.len());
-                sections.push(Section {
-                    name,
-                    line: line_no,
-                    header_span: line_span,
-                    properties: Vec::new(),
-                });
+                sections.push(Section::new(name, line_no, line_span));
             }
             continue;
         }
@@ -339,11 +379,7 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
             line_span: line_span.clone(),
         };
         let section = &mut sections[section_index];
-        if let Some(pos) = section
-            .properties
-            .iter()
-            .position(|p| p.key.eq_ignore_ascii_case(key))
-        {
+        if let Some(pos) = section.position(key) {
             let first_line = section.properties[pos].line;
             section.properties[pos] = property;
             warn(
@@ -356,7 +392,7 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                 format!("key repeated (first at line {first_line}); this later value wins"),
             );
         } else {
-            section.properties.push(property);
+            section.push(property);
         }
     }
     Document {
@@ -408,6 +444,46 @@ mod tests {
         let s = doc.section("1000").unwrap();
         assert_eq!(s.get("a").unwrap().value, "2");
         assert_eq!(s.get("b").unwrap().value, "3");
+    }
+
+    #[test]
+    fn duplicates_in_a_large_section_are_found_by_the_index() {
+        // Past SCAN_LIMIT keys the section is searched by its index: the
+        // same rules (any case, later value wins, the warning names the line
+        // of the value it replaces).
+        let mut text = String::from("[MandatoryObjects]\n");
+        for i in 0..100 {
+            text.push_str(&format!("Key{i}={i}\n"));
+        }
+        text.push_str("KEY7=late\nkey99=later\nKey7=last\n");
+        let (doc, d) = doc(&text);
+        let s = doc.section("mandatoryobjects").unwrap();
+        assert_eq!(s.properties.len(), 100);
+        assert_eq!(s.get("key7").unwrap().value, "last");
+        assert_eq!(s.get("KEY99").unwrap().value, "later");
+        assert_eq!(s.get("Key0").unwrap().line, 2);
+        assert!(s.get("Key100").is_none());
+        let lines: Vec<(Option<u32>, &str)> = d
+            .iter()
+            .map(|d| (d.location.line, d.message.as_str()))
+            .collect();
+        assert_eq!(
+            lines,
+            [
+                (
+                    Some(102),
+                    "key repeated (first at line 9); this later value wins"
+                ),
+                (
+                    Some(103),
+                    "key repeated (first at line 101); this later value wins"
+                ),
+                (
+                    Some(104),
+                    "key repeated (first at line 102); this later value wins"
+                ),
+            ]
+        );
     }
 
     #[test]

@@ -55,15 +55,20 @@ pub(crate) struct Ctx<'a> {
 }
 
 /// The `od` module's items, and the info of every entry by (index, subindex).
-pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>) {
+/// The items of the `od` module, given to `sink` one group of items per
+/// object as they are made (so that they are formatted and dropped one at a
+/// time: see `format.rs`), and what the PDOs need to know of each entry.
+pub(crate) fn emit(
+    cx: &mut Ctx,
+    sink: &mut dyn FnMut(TokenStream),
+) -> BTreeMap<(u16, u8), EntryInfo> {
     let od = od_plan::plan(cx.device, cx.errors, cx.diags);
     let mut infos = BTreeMap::new();
-    let mut items = TokenStream::new();
     for root in &od.root {
         let (object, e) = (root.object, &root.entry);
         let ident = od.root_names.get(e.zst);
         let path = vec![super::naming::ident("od")];
-        items.extend(entry_items(
+        sink(entry_items(
             cx,
             object,
             e.entry,
@@ -122,7 +127,7 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
         doc.origin(&object.origin);
         let doc = doc.tokens_with_alias(&object.name, &module.to_string());
         let index = super::prim::hex(u128::from(object.index));
-        items.extend(quote! {
+        sink(quote! {
             #doc
             pub mod #module {
                 use super::rt;
@@ -132,7 +137,7 @@ pub(crate) fn emit(cx: &mut Ctx) -> (TokenStream, BTreeMap<(u16, u8), EntryInfo>
             }
         });
     }
-    (items, infos)
+    infos
 }
 
 fn info(cx: &Ctx, module: &[Ident], e: &od_plan::EntryPlan, names: &Names) -> EntryInfo {

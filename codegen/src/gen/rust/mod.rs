@@ -24,6 +24,7 @@ mod docs;
 mod entries;
 mod enums;
 mod errors;
+mod format;
 mod hazards;
 pub(crate) mod naming;
 mod objects;
@@ -166,23 +167,32 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
         errors: &error_plans,
         diags: &mut diags,
     };
-    let (od_items, infos) = entries::emit(&mut cx);
+    // Each object's items are formatted as they are made and their tokens
+    // dropped: the tokens of a whole device take many times its text.
+    let mut od_body = String::new();
+    let mut format_error = None;
+    let infos = entries::emit(&mut cx, &mut |items| {
+        if format_error.is_none() {
+            match format::in_module(items) {
+                Ok(text) => od_body.push_str(&text),
+                Err(err) => format_error = Some(err),
+            }
+        }
+    });
     let error_items = errors::emit(device, &error_plans, &rt, &mut diags);
     let pdo_items = pdo::emit(device, &infos, &rt, &mut diags);
     let object_table = objects::emit(device, &rt);
     let identity = identity_items(device);
 
-    let mut file = identity;
-    file.extend(quote! {
+    let od_shell = quote! {
         #[doc = " The object dictionary: one zero-sized type per entry (see the runtime's `od::Entry`)."]
         pub mod od {
             #use_runtime
-            #od_items
-            #object_table
         }
-    });
+    };
+    let mut errors = None;
     if !device.error_tables.is_empty() {
-        file.extend(quote! {
+        errors = Some(quote! {
             #[doc = " Device error tables as enums."]
             pub mod errors {
                 #use_runtime
@@ -190,8 +200,9 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
             }
         });
     }
+    let mut pdo = None;
     if !pdo_items.is_empty() {
-        file.extend(quote! {
+        pdo = Some(quote! {
             #[doc = " Default PDOs: fixed layouts with `encode`/`decode`."]
             pub mod pdo {
                 #use_runtime
@@ -199,8 +210,21 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
             }
         });
     }
-    let code = match syn::parse2::<syn::File>(file) {
-        Ok(parsed) => prettyplease::unparse(&parsed),
+    // A part at a time: the syntax tree of a whole file takes many times
+    // the memory of its tokens (format.rs).
+    let formatted = (|| -> syn::Result<String> {
+        if let Some(err) = format_error {
+            return Err(err);
+        }
+        let mut code = format::file(identity)?;
+        format::module(&mut code, od_shell, &od_body, Some(object_table))?;
+        for module in errors.into_iter().chain(pdo) {
+            code.push_str(&format::file(module)?);
+        }
+        Ok(code)
+    })();
+    let code = match formatted {
+        Ok(code) => code,
         Err(err) => {
             diags.push(Diagnostic {
                 severity: Severity::Error,

@@ -7,58 +7,19 @@ use quote::quote;
 
 use super::entries::data_type_tokens;
 use super::naming;
-use crate::ir::{Access, DataType, Device, Literal, ObjectKind, Value};
+use crate::ir::{Access, DataType, Device, Entry, Literal, Object, ObjectKind, Value};
 
 /// The `OBJECTS` constant, sorted by index and subindex: one
 /// `ObjectInfo::new(..)` per entry, so that each entry is a line or two
 /// (the variants of the runtime's enums imported into the constant's
-/// block).
-pub(crate) fn emit(device: &Device, rt: &TokenStream) -> TokenStream {
-    let mut rows = Vec::new();
+/// block). The rows come apart from the rest so that a table of a million
+/// rows is formatted a part at a time (`format.rs`).
+pub(crate) fn emit<'a>(device: &'a Device, rt: &TokenStream) -> Table<'a> {
     let mut used = Used::default();
-    for object in device.objects.values() {
-        for entry in object.entries.values() {
-            let index = super::prim::hex(u128::from(object.index));
-            let sub = proc_macro2::Literal::u8_unsuffixed(entry.subindex);
-            let name = if matches!(object.kind, ObjectKind::Var | ObjectKind::Domain) {
-                &object.name
-            } else {
-                &entry.name
-            };
-            let data_type = data_type_variant(entry.data_type);
-            let access = match entry.access {
-                Access::Ro => quote!(Ro),
-                Access::Wo => quote!(Wo),
-                Access::Rw => quote!(Rw),
-                Access::Rwr => quote!(Rwr),
-                Access::Rww => quote!(Rww),
-                Access::Const => quote!(Const),
-            };
-            let mappable = entry.pdo_mappable;
-            let mut row = quote!(O::new(#index, #sub, #name, #data_type, #access, #mappable));
-            if let Some((default, number)) = entry.default.as_ref().and_then(default_tokens) {
-                used.default = true;
-                used.number |= number;
-                row.extend(quote!(.with_default(#default)));
-            }
-            let limit = |l: &Option<Literal>| l.as_ref().and_then(|l| number_tokens(&l.value));
-            let (low, high) = (limit(&entry.low_limit), limit(&entry.high_limit));
-            if low.is_some() || high.is_some() {
-                used.number = true;
-                used.some = true;
-                used.none |= low.is_none() || high.is_none();
-                let (low, high) = (option(low), option(high));
-                row.extend(quote!(.with_limits(#low, #high)));
-            }
-            rows.push(row);
-        }
-    }
-    let doc = " Every entry as plain data (index, subindex, name, type, access, default, limits), sorted by index and subindex.";
-    if rows.is_empty() {
-        return quote! {
-            #[doc = #doc]
-            pub const OBJECTS: &[#rt::od::ObjectInfo] = &[];
-        };
+    let mut len = 0;
+    for (object, entry) in entries(device) {
+        row(object, entry, &mut used);
+        len += 1;
     }
     // Only what the rows use is imported (an unused import warns).
     let option: Vec<Ident> = [("None", used.none), ("Some", used.some)]
@@ -75,13 +36,98 @@ pub(crate) fn emit(device: &Device, rt: &TokenStream) -> TokenStream {
         od.push(quote!(Number::*));
     }
     od.push(quote!(ObjectInfo as O));
-    quote! {
-        #[doc = #doc]
-        pub const OBJECTS: &[#rt::od::ObjectInfo] = {
-            #option
-            use #rt::od::{#(#od),*};
-            &[#(#rows,)*]
-        };
+    Table {
+        device,
+        rt: rt.clone(),
+        option,
+        od,
+        len,
+    }
+}
+
+/// Every entry of the table, in its order.
+fn entries(device: &Device) -> impl Iterator<Item = (&Object, &Entry)> {
+    device
+        .objects
+        .values()
+        .flat_map(|object| object.entries.values().map(move |entry| (object, entry)))
+}
+
+/// The `O::new(..)` expression of one entry; `used` gets what it needs imported.
+fn row(object: &Object, entry: &Entry, used: &mut Used) -> TokenStream {
+    let index = super::prim::hex(u128::from(object.index));
+    let sub = proc_macro2::Literal::u8_unsuffixed(entry.subindex);
+    let name = if matches!(object.kind, ObjectKind::Var | ObjectKind::Domain) {
+        &object.name
+    } else {
+        &entry.name
+    };
+    let data_type = data_type_variant(entry.data_type);
+    let access = match entry.access {
+        Access::Ro => quote!(Ro),
+        Access::Wo => quote!(Wo),
+        Access::Rw => quote!(Rw),
+        Access::Rwr => quote!(Rwr),
+        Access::Rww => quote!(Rww),
+        Access::Const => quote!(Const),
+    };
+    let mappable = entry.pdo_mappable;
+    let mut row = quote!(O::new(#index, #sub, #name, #data_type, #access, #mappable));
+    if let Some((default, number)) = entry.default.as_ref().and_then(default_tokens) {
+        used.default = true;
+        used.number |= number;
+        row.extend(quote!(.with_default(#default)));
+    }
+    let limit = |l: &Option<Literal>| l.as_ref().and_then(|l| number_tokens(&l.value));
+    let (low, high) = (limit(&entry.low_limit), limit(&entry.high_limit));
+    if low.is_some() || high.is_some() {
+        used.number = true;
+        used.some = true;
+        used.none |= low.is_none() || high.is_none();
+        let (low, high) = (option(low), option(high));
+        row.extend(quote!(.with_limits(#low, #high)));
+    }
+    row
+}
+
+/// The parts of `OBJECTS`: the rows are made when asked for, a part at a
+/// time, so that the tokens of a table of a million rows are never held
+/// at once.
+pub(crate) struct Table<'a> {
+    device: &'a Device,
+    rt: TokenStream,
+    option: Option<TokenStream>,
+    od: Vec<TokenStream>,
+    /// How many rows.
+    pub len: usize,
+}
+
+impl Table<'_> {
+    /// One `O::new(..)` expression per entry, in order.
+    pub(crate) fn rows(&self) -> impl Iterator<Item = TokenStream> + '_ {
+        entries(self.device).map(|(object, entry)| row(object, entry, &mut Used::default()))
+    }
+
+    /// The constant with `rows` as its elements: with all of
+    /// [`Table::rows`], the whole constant.
+    pub(crate) fn item(&self, rows: &[TokenStream]) -> TokenStream {
+        let doc = " Every entry as plain data (index, subindex, name, type, access, default, limits), sorted by index and subindex.";
+        let rt = &self.rt;
+        if rows.is_empty() {
+            return quote! {
+                #[doc = #doc]
+                pub const OBJECTS: &[#rt::od::ObjectInfo] = &[];
+            };
+        }
+        let (option, od) = (&self.option, &self.od);
+        quote! {
+            #[doc = #doc]
+            pub const OBJECTS: &[#rt::od::ObjectInfo] = {
+                #option
+                use #rt::od::{#(#od),*};
+                &[#(#rows,)*]
+            };
+        }
     }
 }
 
