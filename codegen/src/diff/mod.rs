@@ -34,7 +34,7 @@ mod semantics;
 use serde::Serialize;
 
 use crate::r#gen::rust::od_plan::{DeviceNames, device_names};
-use crate::ir::{Device, Literal, Semantics, Value};
+use crate::ir::{Device, Literal, Value};
 
 /// What a change does to a user.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize)]
@@ -320,7 +320,7 @@ fn strip_semantics(device: &Device) -> Device {
     let mut device = device.clone();
     for object in device.objects.values_mut() {
         for entry in object.entries.values_mut() {
-            entry.semantics = Semantics::default();
+            entry.semantics = Box::default();
         }
     }
     device.error_tables.clear();

@@ -267,13 +267,21 @@ pub struct Entry {
     pub obj_flags: Option<u32>,
     pub denotation: Option<String>,
     /// What the raw value means (YAML only).
-    #[serde(default, skip_serializing_if = "Semantics::is_empty")]
-    pub semantics: Semantics,
+    ///
+    /// Boxed: most entries of a real file have none, and an entry stays
+    /// small (a file of a million sub-entries holds a million of these).
+    #[serde(default, skip_serializing_if = "semantics_is_empty")]
+    pub semantics: Box<Semantics>,
     /// The Rust type name pinned for this entry (YAML `rust_name:`),
     /// UpperCamelCase; it wins over the canonical and the source name.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rust_name: Option<String>,
     pub origin: Origin,
+}
+
+/// Serde's test for an entry's boxed [`Semantics`].
+fn semantics_is_empty(semantics: &Semantics) -> bool {
+    semantics.is_empty()
 }
 
 impl Entry {
@@ -296,7 +304,7 @@ impl Entry {
             parameter_value: None,
             obj_flags: None,
             denotation: None,
-            semantics: Semantics::default(),
+            semantics: Box::default(),
             rust_name: None,
             origin,
         }

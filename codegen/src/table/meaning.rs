@@ -22,7 +22,7 @@ pub(super) fn semantics(
     def: &Spanned<EntryDef>,
     entry: &Entry,
     here: &str,
-) -> Semantics {
+) -> Box<Semantics> {
     let mut out = entry.semantics.clone();
     merge(ctx, &mut out, def, entry.data_type, here);
     out
