@@ -253,7 +253,7 @@ fn round_trip(devices: &[(String, Device)]) -> RoundTrip {
             .values_mut()
             .flat_map(|o| o.entries.values_mut())
         {
-            entry.semantics = Default::default();
+            *entry.semantics = Default::default();
         }
         tally
             .readback_codes

@@ -320,7 +320,7 @@ fn strip_semantics(device: &Device) -> Device {
     let mut device = device.clone();
     for object in device.objects.values_mut() {
         for entry in object.entries.values_mut() {
-            entry.semantics = Box::default();
+            *entry.semantics = Default::default();
         }
     }
     device.error_tables.clear();

@@ -251,7 +251,7 @@ impl Canonical {
         let (m, origin) = self.meaning(index, entry.subindex)?;
         let ty = m.runtime.filter(|t| t.value)?;
         let mut standard = entry.clone();
-        standard.semantics = Default::default();
+        *standard.semantics = Default::default();
         if fits(m, entry.data_type) {
             fill(&mut standard, m, &origin);
         }
