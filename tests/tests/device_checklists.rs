@@ -68,7 +68,12 @@ fn cells(row: &str) -> Vec<String> {
 }
 
 fn entry(device: &Device, index: u16, sub: u8) -> Option<&Entry> {
-    device.objects.get(&index)?.entries.get(&sub)
+    device
+        .objects
+        .get(&index)?
+        .entries
+        .get(&sub)
+        .map(Box::as_ref)
 }
 
 fn int(text: &str) -> Option<i128> {

@@ -30,12 +30,14 @@ fn active(device: &Device, index: u16) -> Option<Vec<u32>> {
     let count = object
         .entries
         .get(&0)
+        .map(Box::as_ref)
         .and_then(raw_mapping)
         .unwrap_or(u32::MAX);
     Some(
         object
             .entries
             .values()
+            .map(Box::as_ref)
             .filter(|e| e.subindex >= 1 && u32::from(e.subindex) <= count)
             .filter_map(raw_mapping)
             .filter(|&raw| raw != 0)

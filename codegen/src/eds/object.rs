@@ -131,7 +131,7 @@ impl Lowering<'_> {
             index,
             name,
             kind,
-            entries,
+            entries: Object::boxed_entries(entries),
             obj_flags,
             denotation,
             compact_sub_obj: compact,

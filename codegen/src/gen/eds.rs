@@ -471,15 +471,16 @@ mod tests {
             rust_name: None,
             origin: Origin::default(),
         };
-        array
-            .entries
-            .insert(0, Entry::highest_subindex(0x1B, Origin::default()));
+        array.entries.insert(
+            0,
+            Box::new(Entry::highest_subindex(0x1B, Origin::default())),
+        );
         for (sub, t, v) in [
             (1, DataType::Integer8, Value::Integer(-128)),
             (2, DataType::VisibleString, Value::Text(String::new())),
             (0x1B, DataType::OctetString, Value::Bytes(vec![])),
         ] {
-            array.entries.insert(sub, entry(sub, t, Some(v)));
+            array.entries.insert(sub, Box::new(entry(sub, t, Some(v))));
         }
         device.objects.insert(0x2000, array);
         let out = to_eds(&device);
@@ -524,7 +525,7 @@ mod tests {
         let mut e = entry(0, DataType::Other(0xFFFF), Some(Value::Integer(i128::MIN)));
         e.low_limit = Some(lit(Value::Real(f64::NAN), true));
         e.high_limit = Some(lit(Value::Bytes(vec![0; 3]), true));
-        var.entries.insert(0, e);
+        var.entries.insert(0, Box::new(e));
         device.objects.insert(0, var);
         let out = to_eds(&device);
         assert!(out.contains("[0000]"));

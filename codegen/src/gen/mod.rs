@@ -195,9 +195,13 @@ mod tests {
         };
         identity
             .entries
-            .insert(0, Entry::highest_subindex(2, Origin::default()));
-        identity.entries.insert(1, var(0x1018, 1, "Vendor-ID"));
-        identity.entries.insert(2, var(0x1018, 2, "Product code"));
+            .insert(0, Box::new(Entry::highest_subindex(2, Origin::default())));
+        identity
+            .entries
+            .insert(1, Box::new(var(0x1018, 1, "Vendor-ID")));
+        identity
+            .entries
+            .insert(2, Box::new(var(0x1018, 2, "Product code")));
         d.objects.insert(0x1018, identity);
         d.identity.product_number = Some(1);
         d.variants.push(Variant {

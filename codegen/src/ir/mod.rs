@@ -203,7 +203,11 @@ pub struct Object {
     pub name: String,
     pub kind: ObjectKind,
     /// For a VAR or DOMAIN the single entry has subindex 0.
-    pub entries: BTreeMap<u8, Entry>,
+    ///
+    /// Boxed: a map reserves room for several values in each of its nodes,
+    /// and most objects hold one entry (a VAR), so that an object costs the
+    /// size of its entries, not of a node of unboxed entries.
+    pub entries: BTreeMap<u8, Box<Entry>>,
     pub obj_flags: Option<u32>,
     pub denotation: Option<String>,
     /// Set when the sub-entries were expanded from `CompactSubObj`.
@@ -282,6 +286,16 @@ pub struct Entry {
 /// Serde's test for an entry's boxed [`Semantics`].
 fn semantics_is_empty(semantics: &Semantics) -> bool {
     semantics.is_empty()
+}
+
+impl Object {
+    /// Entries by sub-index, each boxed as [`Object::entries`] holds them.
+    pub fn boxed_entries(entries: BTreeMap<u8, Entry>) -> BTreeMap<u8, Box<Entry>> {
+        entries
+            .into_iter()
+            .map(|(sub, entry)| (sub, Box::new(entry)))
+            .collect()
+    }
 }
 
 impl Entry {

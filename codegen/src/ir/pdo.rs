@@ -212,11 +212,13 @@ pub fn total_bits(device: &Device, mapping_index: u16) -> u32 {
     let count = object
         .entries
         .get(&0)
+        .map(Box::as_ref)
         .and_then(raw_mapping)
         .map_or(u32::MAX, |n| n);
     object
         .entries
         .values()
+        .map(Box::as_ref)
         .filter(|e| e.subindex >= 1 && u32::from(e.subindex) <= count)
         .filter_map(raw_mapping)
         .map(|raw| u32::from(MappedObject::from_raw(raw).bits))

@@ -197,7 +197,7 @@ pub(super) fn add(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>) {
             index,
             name,
             kind: object_kind,
-            entries,
+            entries: Object::boxed_entries(entries),
             obj_flags: None,
             denotation: None,
             compact_sub_obj: None,
@@ -652,7 +652,7 @@ pub(super) fn modify(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>
         if matches!(object.kind, ObjectKind::Var | ObjectKind::Domain) && d.name.is_some() {
             object.name = entry.name.clone();
         }
-        object.entries.insert(sub, entry);
+        object.entries.insert(sub, Box::new(entry));
     }
 }
 
@@ -677,7 +677,7 @@ pub(super) fn find_entry<'d>(
             None
         }
         Some(object) => {
-            let entry = object.entries.get(&sub);
+            let entry = object.entries.get(&sub).map(Box::as_ref);
             if entry.is_none() {
                 ctx.error(
                     "table::missing-entry",

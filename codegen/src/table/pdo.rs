@@ -246,7 +246,7 @@ fn record(index: u16, name: String, entries: BTreeMap<u8, Entry>, origin: Origin
         index,
         name,
         kind: ObjectKind::Record,
-        entries,
+        entries: Object::boxed_entries(entries),
         obj_flags: None,
         denotation: None,
         compact_sub_obj: None,

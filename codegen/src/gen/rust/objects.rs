@@ -50,7 +50,7 @@ fn entries(device: &Device) -> impl Iterator<Item = (&Object, &Entry)> {
     device
         .objects
         .values()
-        .flat_map(|object| object.entries.values().map(move |entry| (object, entry)))
+        .flat_map(|object| object.entries.values().map(move |entry| (object, &**entry)))
 }
 
 /// The `O::new(..)` expression of one entry; `used` gets what it needs imported.

@@ -286,6 +286,7 @@ fn indexed_elements<'d>(
     let elements: Vec<&Entry> = object
         .entries
         .values()
+        .map(Box::as_ref)
         .filter(|e| e.subindex >= 1)
         .skip_while(|e| named(e))
         .collect();

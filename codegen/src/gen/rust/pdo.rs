@@ -141,6 +141,7 @@ fn layout<'a>(
     let count = mapping
         .entries
         .get(&0)
+        .map(Box::as_ref)
         .and_then(raw_mapping)
         .unwrap_or(u32::MAX);
     let name = format!("{direction:?}{number}").to_uppercase();
