@@ -28,6 +28,7 @@ pub mod eds;
 pub mod r#gen;
 pub mod input;
 pub mod ir;
+pub mod network;
 pub mod profiles;
 pub mod read;
 pub mod table;
