@@ -13,6 +13,7 @@
 mod decode;
 mod live;
 mod monitor;
+mod net;
 mod sim;
 
 use std::io::Write;
@@ -156,11 +157,14 @@ enum Command {
     /// Layer setting services (CiA 305): fastscan, node ids.
     #[command(subcommand)]
     Lss(live::LssCommand),
+    /// Commands on a whole network described by a bus file (bus.yml).
+    #[command(subcommand)]
+    Net(net::NetCommand),
 }
 
 /// How strictly to read, and the levels of single rules.
 #[derive(Args)]
-struct ReadArgs {
+pub(crate) struct ReadArgs {
     /// Turn warnings into errors (but those of allowed rules).
     #[arg(long)]
     strict: bool,
@@ -183,7 +187,7 @@ struct ReadArgs {
 
 impl ReadArgs {
     /// The reading options, or the usage error of a code that names no rule.
-    fn options(&self) -> Result<Options, String> {
+    pub(crate) fn options(&self) -> Result<Options, String> {
         let mut levels = Levels::new();
         for code in &self.allow {
             levels.allow(code, "--allow");
@@ -256,7 +260,8 @@ fn main() -> ExitCode {
         | Command::Nmt(_)
         | Command::Scan(_)
         | Command::Od(_)
-        | Command::Lss(_) => Ok(Options::default()),
+        | Command::Lss(_)
+        | Command::Net(_) => Ok(Options::default()),
     };
     let options = match read {
         Ok(options) => options,
@@ -288,6 +293,7 @@ fn main() -> ExitCode {
         Command::Scan(args) => live::run_scan(args),
         Command::Od(cmd) => live::run_od(cmd),
         Command::Lss(cmd) => live::run_lss(cmd),
+        Command::Net(cmd) => net::run(cmd),
         Command::Check { files, .. } => check(&files, &options),
         Command::Dump {
             format: Format::Json,

@@ -1,0 +1,25 @@
+//! `eds2rust net`: commands on a whole network, described by a bus file
+//! (lely dcfgen's YAML, as ros2_canopen users write it).
+
+mod check;
+mod dcf;
+
+use std::process::ExitCode;
+
+use clap::Subcommand;
+
+#[derive(Subcommand)]
+pub(crate) enum NetCommand {
+    /// Checks a whole bus: node ids, COB-IDs, PDO mappings, SDO writes,
+    /// heartbeat times, bus load.
+    Check(check::CheckArgs),
+    /// Writes master.dcf and the concise DCFs (.bin) that dcfgen writes.
+    Dcf(dcf::DcfArgs),
+}
+
+pub(crate) fn run(command: NetCommand) -> ExitCode {
+    match command {
+        NetCommand::Check(args) => check::run(args),
+        NetCommand::Dcf(args) => dcf::run(args),
+    }
+}
