@@ -274,6 +274,25 @@ impl Diagnostics {
     }
 }
 
+/// The byte range of 1-based line `line` of `text` (without its line
+/// end), to underline a whole line; an empty range at the end past the
+/// last line.
+pub fn line_span(text: &str, line: u32) -> Range<usize> {
+    // Line n starts after the (n-1)th newline.
+    let newlines = usize::try_from(line)
+        .unwrap_or(usize::MAX)
+        .saturating_sub(1);
+    let start = match newlines.checked_sub(1) {
+        None => 0,
+        Some(k) => text
+            .match_indices('\n')
+            .nth(k)
+            .map_or(text.len(), |(i, _)| i + 1),
+    };
+    let end = text[start..].find('\n').map_or(text.len(), |n| start + n);
+    start..end
+}
+
 /// Terminal-safe text: [`crate::text::terminal`] (escape sequences and
 /// bidi controls as `?`, byte offsets kept).
 fn printable(text: &str) -> String {

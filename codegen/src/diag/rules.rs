@@ -160,6 +160,62 @@ pub const RULES: &[Rule] = &[
         "an input file above the size limit (--max-input-size)",
     ),
     rule(
+        "net::bus-load",
+        "an estimated bus load above the limit (--max-bus-load)",
+    ),
+    rule(
+        "net::cob-id-collision",
+        "two nodes sending on one COB-ID",
+    ),
+    rule(
+        "net::cob-id-restricted",
+        "a PDO COB-ID in a range CiA 301 restricts",
+    ),
+    rule(
+        "net::heartbeat-and-guarding",
+        "a node with both a heartbeat and node guarding",
+    ),
+    rule(
+        "net::heartbeat-no-producer",
+        "a heartbeat consumer of a node that sends none",
+    ),
+    rule(
+        "net::heartbeat-timing",
+        "a heartbeat consumer time not above its producer time",
+    ),
+    rule(
+        "net::node-id",
+        "a node id outside 1..=127",
+    ),
+    rule(
+        "net::node-id-collision",
+        "two nodes with one node id",
+    ),
+    rule(
+        "net::pdo-direction",
+        "a bus file's PDO mapping against the entry's access",
+    ),
+    rule(
+        "net::pdo-mapping",
+        "a bus file's PDO mapping of an object that is missing or not mappable",
+    ),
+    rule(
+        "net::pdo-too-long",
+        "a bus file's PDO mapping of more than 64 bits",
+    ),
+    rule(
+        "net::pdo-unconsumed",
+        "a PDO sent that no node reads",
+    ),
+    rule(
+        "net::pdo-unproduced",
+        "a PDO awaited that is never sent",
+    ),
+    rule(
+        "net::sdo-pdo-conflict",
+        "an `sdo:` write to a PDO parameter that the PDO sections set or do not see",
+    ),
+    rule(
         "table::array-type",
         "an ARRAY whose subs do not share one type",
     ),
@@ -366,7 +422,7 @@ mod tests {
                     let Some((area, name)) = word.split_once("::") else {
                         continue;
                     };
-                    let is_code = ["build", "eds", "gen", "input", "table"].contains(&area)
+                    let is_code = ["build", "eds", "gen", "input", "net", "table"].contains(&area)
                         && !name.is_empty()
                         && name
                             .bytes()

@@ -3,6 +3,7 @@
 //! ([`config`]), checked as a whole, and written as master.dcf and concise
 //! DCFs.
 
+pub mod check;
 pub mod config;
 pub mod model;
 

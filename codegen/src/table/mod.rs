@@ -223,19 +223,7 @@ impl At {
     /// The byte range to underline: the scalar, or the rest of its line.
     fn span(self, text: &str) -> std::ops::Range<usize> {
         if self.offset == usize::MAX {
-            // Line n starts after the (n-1)th newline.
-            let newlines = usize::try_from(self.line)
-                .unwrap_or(usize::MAX)
-                .saturating_sub(1);
-            let start = match newlines.checked_sub(1) {
-                None => 0,
-                Some(k) => text
-                    .match_indices('\n')
-                    .nth(k)
-                    .map_or(text.len(), |(i, _)| i + 1),
-            };
-            let end = text[start..].find('\n').map_or(text.len(), |n| start + n);
-            return start..end;
+            return crate::diag::line_span(text, self.line);
         }
         let start = self.offset.min(text.len());
         if !text.is_char_boundary(start) {
