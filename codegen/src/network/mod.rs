@@ -4,7 +4,10 @@
 //! DCFs.
 
 pub mod config;
+mod configure;
 pub mod model;
+mod pdo_config;
+mod view;
 
 use std::path::{Path, PathBuf};
 
