@@ -160,20 +160,21 @@ pub const RULES: &[Rule] = &[
         "an input file above the size limit (--max-input-size)",
     ),
     rule(
+        "net::auto-cob-id",
+        "a PDO with cob_id: auto when no 11-bit COB-ID is left (0x680–0x6DF used up)",
+    ),
+    rule(
         "net::bus-load",
         "an estimated bus load above the limit (--max-bus-load)",
     ),
-    rule(
-        "net::cob-id-collision",
-        "two nodes sending on one COB-ID",
-    ),
+    rule("net::cob-id-collision", "two nodes sending on one COB-ID"),
     rule(
         "net::cob-id-restricted",
         "a PDO COB-ID in a range CiA 301 restricts",
     ),
     rule(
         "net::heartbeat-and-guarding",
-        "a node with both a heartbeat and node guarding",
+        "a node with both a heartbeat producer time and node guarding",
     ),
     rule(
         "net::heartbeat-no-producer",
@@ -184,12 +185,26 @@ pub const RULES: &[Rule] = &[
         "a heartbeat consumer time not above its producer time",
     ),
     rule(
-        "net::node-id",
-        "a node id outside 1..=127",
+        "net::identity-differs",
+        "a bus file's revision or serial number that differs from the device file's",
     ),
     rule(
-        "net::node-id-collision",
-        "two nodes with one node id",
+        "net::missing-object",
+        "a bus file setting whose object the device file lacks (0x1012, 0x1016, 0x1017, 0x100C, 0x100D, 0x1029, 0x1F56, 0x1011)",
+    ),
+    rule(
+        "net::no-node-id",
+        "a slave without a node id, left out of the network",
+    ),
+    rule(
+        "net::no-such-pdo",
+        "an rpdo/tpdo number the device file has no PDO for",
+    ),
+    rule("net::node-id", "a node id outside 1..=127"),
+    rule("net::node-id-collision", "two nodes with one node id"),
+    rule(
+        "net::not-writable",
+        "a configuration write to an entry that is not writable",
     ),
     rule(
         "net::pdo-direction",
@@ -197,23 +212,25 @@ pub const RULES: &[Rule] = &[
     ),
     rule(
         "net::pdo-mapping",
-        "a bus file's PDO mapping of an object that is missing or not mappable",
+        "a bus file's PDO mapping of an object that is not PDO-mappable",
     ),
     rule(
         "net::pdo-too-long",
         "a bus file's PDO mapping of more than 64 bits",
     ),
-    rule(
-        "net::pdo-unconsumed",
-        "a PDO sent that no node reads",
-    ),
-    rule(
-        "net::pdo-unproduced",
-        "a PDO awaited that is never sent",
-    ),
+    rule("net::pdo-unconsumed", "a PDO sent that no node reads"),
+    rule("net::pdo-unproduced", "a PDO awaited that is never sent"),
     rule(
         "net::sdo-pdo-conflict",
         "an `sdo:` write to a PDO parameter that the PDO sections set or do not see",
+    ),
+    rule(
+        "net::unknown-object",
+        "a write or mapping of an object or sub-object the device file lacks",
+    ),
+    rule(
+        "net::value-range",
+        "a configuration value that does not fit its entry's data type",
     ),
     rule(
         "table::array-type",

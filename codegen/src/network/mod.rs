@@ -5,7 +5,10 @@
 
 pub mod check;
 pub mod config;
+mod configure;
 pub mod model;
+mod pdo_config;
+mod view;
 
 use std::path::{Path, PathBuf};
 

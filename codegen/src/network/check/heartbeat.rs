@@ -1,6 +1,8 @@
 //! Error control: `net::heartbeat-timing` (a consumer time that cannot
 //! hold for its producer), `net::heartbeat-no-producer` (a consumer of a
-//! heartbeat no node sends), `net::heartbeat-and-guarding`.
+//! heartbeat no node sends). Heartbeat and node guarding both set
+//! (`net::heartbeat-and-guarding`) is reported by the configuration,
+//! which drops the guarding as dcfgen does.
 //!
 //! dcfgen sets every consumer time to the producer time times the
 //! multiplier, truncated and cut to 16 bits (`int(p * m) & 0xFFFF`): the
@@ -17,7 +19,6 @@ pub(super) fn check(net: &Net, report: &mut Report) {
     slaves_consume_master(net, report);
     for (node, slave) in net.nodes() {
         device_consumers(net, node, slave, report);
-        guarding(node, slave, report);
     }
 }
 
@@ -100,7 +101,10 @@ fn master_consumes(net: &Net, report: &mut Report) {
         report.error(
             "net::heartbeat-timing",
             &spot,
-            format!("the master consumes `{}`'s heartbeat with {problem}", node.name),
+            format!(
+                "the master consumes `{}`'s heartbeat with {problem}",
+                node.name
+            ),
             vec![timing_fix(producer)],
         );
     }
@@ -217,54 +221,11 @@ fn device_consumers(net: &Net, node: &Node, slave: &SlaveSection, report: &mut R
                 vec![format!(
                     "write a longer time with an `sdo:` write to 0x1016 sub {sub}: \
                      `value: 0x{:08X}` ({} ms)",
-                    (u32::from(id) << 16) | u32::from(producer.saturating_mul(3).max(producer)),
-                    producer.saturating_mul(3)
+                    (u32::from(id) << 16) | (u32::from(producer) * 3).min(0xFFFF),
+                    (u32::from(producer) * 3).min(0xFFFF)
                 )],
             ),
             Some(_) => {}
         }
     }
-}
-
-/// `net::heartbeat-and-guarding`: a slave with a heartbeat and node
-/// guarding both set (dcfgen keeps the heartbeat).
-fn guarding(node: &Node, slave: &SlaveSection, report: &mut Report) {
-    if node.heartbeat_producer == 0 {
-        return;
-    }
-    let device = |index: u16| device_int(&slave.device, index, 0, node.node_id).unwrap_or(0);
-    let guard = slave
-        .guard_time
-        .as_ref()
-        .map_or_else(|| device(0x100C), |g| i128::from(g.value));
-    let life = slave
-        .life_time_factor
-        .as_ref()
-        .map_or_else(|| device(0x100D), |l| i128::from(l.value));
-    if guard == 0 || life == 0 {
-        return;
-    }
-    let spot = first_spot(
-        &[
-            slave.guard_time.as_ref().map(|g| &g.spot),
-            slave.life_time_factor.as_ref().map(|l| &l.spot),
-            slave.heartbeat_producer.as_ref().map(|h| &h.spot),
-        ],
-        &slave.spot,
-    );
-    report.warning(
-        "net::heartbeat-and-guarding",
-        &spot,
-        format!(
-            "`{}` has a heartbeat ({} ms) and node guarding (guard time {guard} ms, life time \
-             factor {life}); a node runs one of them, and dcfgen keeps the heartbeat and \
-             drops guarding",
-            slave.name, node.heartbeat_producer
-        ),
-        vec![
-            "drop `guard_time`/`life_time_factor`, or write `heartbeat_producer: 0` to \
-             guard the node"
-                .into(),
-        ],
-    );
 }

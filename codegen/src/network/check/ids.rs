@@ -161,8 +161,16 @@ fn producers(net: &Net) -> Vec<Producer> {
             ..service(0, "TIME".into(), &net.master_spot("time_cob_id"))
         });
     }
-    out.push(service(0x7E4, "LSS (the slaves' responses)".into(), &master.spot));
-    out.push(service(0x7E5, "LSS (the master's requests)".into(), &master.spot));
+    out.push(service(
+        0x7E4,
+        "LSS (the slaves' responses)".into(),
+        &master.spot,
+    ));
+    out.push(service(
+        0x7E5,
+        "LSS (the master's requests)".into(),
+        &master.spot,
+    ));
     let mut ids = Vec::new();
     if let Some(m) = net.master_id() {
         ids.push(m);
@@ -228,7 +236,12 @@ fn node_services(out: &mut Vec<Producer>, id: u8, who: &str, emcy: u32, spot: &S
     push((0x700 + id32, false), "heartbeat/boot-up");
 }
 
-fn pdo_producer(pdo: &Pdo, who: String, slave_spot: &Spot, mirrors: Option<(String, u16)>) -> Producer {
+fn pdo_producer(
+    pdo: &Pdo,
+    who: String,
+    slave_spot: &Spot,
+    mirrors: Option<(String, u16)>,
+) -> Producer {
     Producer {
         id: can_id(pdo.cob_id),
         who,

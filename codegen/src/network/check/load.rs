@@ -122,7 +122,8 @@ pub fn bus_load(bus: &Bus, configured: &Configured) -> BusLoad {
         });
     }
     if master.heartbeat_producer > 0 {
-        load.items.push(heartbeat("the master", master.heartbeat_producer));
+        load.items
+            .push(heartbeat("the master", master.heartbeat_producer));
     }
     for node in &configured.nodes {
         for pdo in &node.tpdos {
@@ -134,7 +135,8 @@ pub fn bus_load(bus: &Bus, configured: &Configured) -> BusLoad {
             pdo_load(&mut load, what, pdo, sync);
         }
         if node.heartbeat_producer > 0 {
-            load.items.push(heartbeat(&node.name, node.heartbeat_producer));
+            load.items
+                .push(heartbeat(&node.name, node.heartbeat_producer));
         }
         if node.guard_time > 0 && node.life_time_factor > 0 {
             let rate = 1000.0 / f64::from(node.guard_time);

@@ -155,7 +155,9 @@ impl<'t> Report<'t> {
             file: self.file.clone(),
             location: Location {
                 line,
-                span: line.and(self.text).map(|t| crate::diag::line_span(t, spot.line)),
+                span: line
+                    .and(self.text)
+                    .map(|t| crate::diag::line_span(t, spot.line)),
                 section: None,
                 key: (!spot.key.is_empty()).then(|| spot.key.clone()),
             },

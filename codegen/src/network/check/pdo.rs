@@ -18,7 +18,7 @@ use std::collections::BTreeMap;
 
 use super::{Net, Report, device_int};
 use crate::ir::pdo::{MappedObject, MappingProblem, check_entry, mappable_bits};
-use crate::ir::{Device, PdoDirection};
+use crate::ir::{DataType, Device, PdoDirection};
 use crate::network::config::{Node, Pdo};
 use crate::network::model::{MappingItem, PdoSection, SdoItem, SlaveSection, Spot};
 
@@ -47,37 +47,29 @@ fn sections(slave: &SlaveSection) -> [(PdoDirection, &BTreeMap<u16, PdoSection>)
     ]
 }
 
-/// The entry a mapping item maps and the bit length dcfgen maps it with
-/// (the type's shortest: 1 for BOOLEAN), or the problems of the item.
-fn resolve(device: &Device, item: &MappingItem) -> Result<MappedObject, Vec<String>> {
-    let entry = device
-        .objects
-        .get(&item.index)
-        .and_then(|o| o.entries.get(&item.sub_index));
-    let Some(entry) = entry else {
-        let probe = MappedObject {
-            index: item.index,
-            subindex: item.sub_index,
-            bits: 8,
-        };
-        return Err(check_entry(device, probe.raw())
-            .iter()
-            .map(ToString::to_string)
-            .collect());
-    };
-    let Some(bits) = mappable_bits(entry.data_type) else {
-        return Err(vec![format!(
-            "maps 0x{:04X} sub {} (`{}`), a {} without a fixed length to map",
-            item.index,
-            item.sub_index,
-            entry.name,
-            entry.data_type.name()
-        )]);
-    };
-    Ok(MappedObject {
+/// What a mapping item maps, with the bit length dcfgen maps it with (the
+/// type's shortest: 1 for BOOLEAN); `None` when the object does not exist
+/// or has no fixed length (the configuration reports that,
+/// `net::unknown-object`).
+fn resolve(device: &Device, item: &MappingItem) -> Option<MappedObject> {
+    let probe = MappedObject {
         index: item.index,
         subindex: item.sub_index,
-        bits: bits[0],
+        bits: 0,
+    };
+    let data_type = if probe.is_dummy() {
+        DataType::from_code(item.index)
+    } else {
+        device
+            .objects
+            .get(&item.index)?
+            .entries
+            .get(&item.sub_index)?
+            .data_type
+    };
+    Some(MappedObject {
+        bits: mappable_bits(data_type)?[0],
+        ..probe
     })
 }
 
@@ -86,7 +78,6 @@ fn resolve(device: &Device, item: &MappingItem) -> Result<MappedObject, Vec<Stri
 /// the device reader's to check).
 fn mappings(slave: &SlaveSection, report: &mut Report) {
     let device = &slave.device;
-    let file = &device.source;
     for (direction, sections) in sections(slave) {
         for (&n, section) in sections {
             let Some(items) = &section.mapping else {
@@ -95,21 +86,8 @@ fn mappings(slave: &SlaveSection, report: &mut Report) {
             let pdo = label(direction, n);
             let mut total = 0u32;
             for item in items {
-                let mapped = match resolve(device, item) {
-                    Ok(mapped) => mapped,
-                    Err(problems) => {
-                        for problem in problems {
-                            report.error(
-                                "net::pdo-mapping",
-                                &item.spot,
-                                format!("{pdo} of `{}` {problem}", slave.name),
-                                vec![format!(
-                                    "check the index and sub-index against the device file {file}"
-                                )],
-                            );
-                        }
-                        continue;
-                    }
+                let Some(mapped) = resolve(device, item) else {
+                    continue;
                 };
                 total += u32::from(mapped.bits);
                 for problem in check_entry(device, mapped.raw()) {
@@ -125,7 +103,11 @@ fn mappings(slave: &SlaveSection, report: &mut Report) {
                         notes,
                     );
                 }
-                let entry = &device.objects[&item.index].entries[&item.sub_index];
+                let entry = device
+                    .objects
+                    .get(&item.index)
+                    .and_then(|o| o.entries.get(&item.sub_index));
+                let Some(entry) = entry else { continue };
                 if !direction.allows(entry.access) {
                     let (verb, way, other) = match direction {
                         PdoDirection::Rpdo => ("writes", "writable", "a TPDO"),
@@ -193,20 +175,27 @@ fn section_sets(
             k => match items.get(usize::from(k) - 1) {
                 Some(item) => value(
                     &item.spot,
-                    resolve(device, item).ok().map(|m| i128::from(m.raw())),
+                    resolve(device, item).map(|m| i128::from(m.raw())),
                 ),
                 None => value(spot, None),
             },
         };
     }
     let field = |f: &Option<crate::network::model::At<u16>>| {
-        f.as_ref().map_or(Sets::Nothing, |a| value(&a.spot, Some(i128::from(a.value))))
+        f.as_ref()
+            .map_or(Sets::Nothing, |a| value(&a.spot, Some(i128::from(a.value))))
     };
     match sub {
         1 => {
-            let spot = section.cob_id.as_ref().map_or(&section.enabled.spot, |c| &c.spot);
+            let spot = section
+                .cob_id
+                .as_ref()
+                .map_or(&section.enabled.spot, |c| &c.spot);
             let spot = if spot.line == 0 { &section.spot } else { spot };
-            value(spot, Some(pdo.map_or(0x8000_0000, |p| i128::from(p.cob_id))))
+            value(
+                spot,
+                Some(pdo.map_or(0x8000_0000, |p| i128::from(p.cob_id))),
+            )
         }
         2 => section
             .transmission
@@ -256,7 +245,11 @@ fn sdo_write(slave: &SlaveSection, node: &Node, item: &SdoItem, report: &mut Rep
         "this SDO write sets 0x{:04X} sub {} ({pdo_name}'s {}) to {}",
         item.index,
         item.sub_index,
-        if mapping { "mapping" } else { "communication parameter" },
+        if mapping {
+            "mapping"
+        } else {
+            "communication parameter"
+        },
         item.value
     );
     let sets = sections.get(&n).map_or(Sets::Nothing, |s| {
@@ -267,7 +260,10 @@ fn sdo_write(slave: &SlaveSection, node: &Node, item: &SdoItem, report: &mut Rep
             report.warning(
                 "net::sdo-pdo-conflict",
                 &item.spot,
-                format!("{what}, which `{}` (line {}) sets already", spot.key, spot.line),
+                format!(
+                    "{what}, which `{}` (line {}) sets already",
+                    spot.key, spot.line
+                ),
                 vec!["drop the SDO write".into()],
             );
         }
@@ -276,7 +272,10 @@ fn sdo_write(slave: &SlaveSection, node: &Node, item: &SdoItem, report: &mut Rep
             report.error(
                 "net::sdo-pdo-conflict",
                 &item.spot,
-                format!("{what}, but `{}` (line {}) sets it{set}", spot.key, spot.line),
+                format!(
+                    "{what}, but `{}` (line {}) sets it{set}",
+                    spot.key, spot.line
+                ),
                 vec![
                     "the SDO list is written last, so the device gets the SDO value while \
                      master.dcf and the generated network follow the section; drop the SDO \
