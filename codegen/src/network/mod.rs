@@ -5,6 +5,7 @@
 
 pub mod config;
 mod configure;
+pub use configure::configure;
 pub mod model;
 mod pdo_config;
 mod view;
