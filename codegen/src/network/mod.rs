@@ -6,6 +6,7 @@
 pub mod check;
 pub mod config;
 mod configure;
+pub use configure::configure;
 pub mod model;
 mod pdo_config;
 mod view;
