@@ -229,3 +229,8 @@ fn device_consumers(net: &Net, node: &Node, slave: &SlaveSection, report: &mut R
         }
     }
 }
+
+#[cfg(test)]
+pub(super) fn consumer_time_for_tests(producer: u16, multiplier: f64) -> u16 {
+    consumer_time(producer, multiplier).0
+}

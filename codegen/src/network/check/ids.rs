@@ -41,6 +41,8 @@ struct Producer {
     /// A PDO (its COB-ID is configurable) rather than a service fixed by
     /// the node id.
     pdo: bool,
+    /// A PDO the bus file configures (not the device file's default).
+    written: bool,
     /// For a PDO the master sends for a slave's RPDO: that slave's name
     /// and the RPDO number.
     mirrors: Option<(String, u16)>,
@@ -142,6 +144,7 @@ fn producers(net: &Net) -> Vec<Producer> {
         who,
         spot: spot.clone(),
         pdo: false,
+        written: false,
         mirrors: None,
         time: false,
     };
@@ -154,13 +157,12 @@ fn producers(net: &Net) -> Vec<Producer> {
             &net.master_spot("sync_period"),
         ));
     }
-    if master.time_cob_id & 0x8000_0000 == 0 || master.time_cob_id & 0x4000_0000 != 0 {
-        out.push(Producer {
-            id: can_id(master.time_cob_id),
-            time: true,
-            ..service(0, "TIME".into(), &net.master_spot("time_cob_id"))
-        });
-    }
+    // TIME's COB-ID is kept free whether the master sends or receives it.
+    out.push(Producer {
+        id: can_id(master.time_cob_id),
+        time: true,
+        ..service(0, "TIME".into(), &net.master_spot("time_cob_id"))
+    });
     out.push(service(
         0x7E4,
         "LSS (the slaves' responses)".into(),
@@ -178,18 +180,21 @@ fn producers(net: &Net) -> Vec<Producer> {
         node_services(&mut out, m, "the master", 0x80 + u32::from(m), &spot);
     }
     for (node, slave) in net.nodes() {
+        // A node whose id is out of range or taken: its COB-IDs follow
+        // from the id, and `net::node-id*` reports that already.
+        if !crate::ir::NODE_IDS.contains(&node.node_id) || ids.contains(&node.node_id) {
+            continue;
+        }
+        ids.push(node.node_id);
         let spot = Net::node_id_spot(slave);
-        if crate::ir::NODE_IDS.contains(&node.node_id) && !ids.contains(&node.node_id) {
-            ids.push(node.node_id);
-            let who = format!("slave `{}`", node.name);
-            node_services(&mut out, node.node_id, &who, node.emcy_cob_id, &spot);
-            if node.time_cob_id & 0x4000_0000 != 0 {
-                out.push(Producer {
-                    id: can_id(node.time_cob_id),
-                    time: true,
-                    ..service(0, format!("TIME ({who})"), &spot)
-                });
-            }
+        let who = format!("slave `{}`", node.name);
+        node_services(&mut out, node.node_id, &who, node.emcy_cob_id, &spot);
+        if node.time_cob_id & 0x4000_0000 != 0 {
+            out.push(Producer {
+                id: can_id(node.time_cob_id),
+                time: true,
+                ..service(0, format!("TIME ({who})"), &spot)
+            });
         }
         for pdo in &node.tpdos {
             out.push(pdo_producer(
@@ -224,6 +229,7 @@ fn node_services(out: &mut Vec<Producer>, id: u8, who: &str, emcy: u32, spot: &S
             who: format!("{what} of {who} (node {id})"),
             spot: spot.clone(),
             pdo: false,
+            written: false,
             mirrors: None,
             time: false,
         });
@@ -247,6 +253,7 @@ fn pdo_producer(
         who,
         spot: pdo.spot.clone().unwrap_or_else(|| slave_spot.clone()),
         pdo: true,
+        written: pdo.spot.is_some(),
         mirrors,
         time: false,
     }
@@ -270,7 +277,10 @@ fn collisions(producers: &[Producer], report: &mut Report) {
         else {
             continue;
         };
-        let spot = if later.pdo || !first.pdo {
+        // Where the fix is: a PDO the bus file configures, else a PDO,
+        // else the later node.
+        let rank = |p: &Producer| u8::from(p.pdo) + u8::from(p.written);
+        let spot = if rank(later) >= rank(first) {
             &later.spot
         } else {
             &first.spot
