@@ -207,6 +207,25 @@ impl Diagnostics {
             .sort_by(|a, b| (&a.file, a.location.line).cmp(&(&b.file, b.location.line)));
     }
 
+    /// Gives every diagnostic that has a line but no span the span of its
+    /// whole line, where its file's text is registered
+    /// ([`add_source`](Self::add_source)), so that rendering shows the line.
+    pub fn span_lines(&mut self) {
+        self.flush_caps();
+        for d in &mut self.items {
+            if d.location.span.is_some() {
+                continue;
+            }
+            let (Some(line), Some((_, text))) = (
+                d.location.line,
+                self.sources.iter().find(|(name, _)| *name == d.file),
+            ) else {
+                continue;
+            };
+            d.location.span = Some(line_span(text, line));
+        }
+    }
+
     /// Renders every diagnostic with its source line, without colours.
     pub fn render(&self) -> String {
         self.render_where(|_| true)
