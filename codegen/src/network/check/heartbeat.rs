@@ -52,18 +52,13 @@ fn timing_problem(producer: u16, multiplier: f64) -> Option<String> {
 }
 
 fn timing_fix(producer: u16) -> String {
-    let most = 65535 / u32::from(producer.max(1));
-    format!(
-        "use a `heartbeat_multiplier` above 1 (dcfgen's default is 3){}",
-        if most < 3 {
-            format!(
-                " and at most {most}, or a shorter `heartbeat_producer`: the consumer time \
-                 must fit 16 bits (65535 ms)"
-            )
-        } else {
-            String::new()
-        }
-    )
+    if u32::from(producer) * 3 <= 0xFFFF {
+        "use a `heartbeat_multiplier` above 1 (dcfgen's default is 3)".into()
+    } else {
+        "shorten `heartbeat_producer`: the consumer time (producer time × multiplier) \
+         must fit 16 bits (65535 ms), so with dcfgen's multiplier 3 at most 21845 ms"
+            .into()
+    }
 }
 
 fn first_spot(candidates: &[Option<&Spot>], fallback: &Spot) -> Spot {

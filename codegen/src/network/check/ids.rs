@@ -5,7 +5,7 @@ use std::collections::BTreeMap;
 
 use super::{Net, Report};
 use crate::network::config::Pdo;
-use crate::network::model::Spot;
+use crate::network::model::{PdoSection, Spot};
 
 /// The ranges of 11-bit CAN-IDs that CiA 301 restricts (no PDO, SYNC,
 /// TIME or EMCY may use them), each with what it is kept for.
@@ -200,7 +200,7 @@ fn producers(net: &Net) -> Vec<Producer> {
             out.push(pdo_producer(
                 pdo,
                 format!("TPDO {} of slave `{}`", pdo.number, node.name),
-                &slave.spot,
+                cob_id_spot(slave.tpdo.get(&pdo.number), pdo, &slave.spot),
                 None,
             ));
         }
@@ -211,7 +211,7 @@ fn producers(net: &Net) -> Vec<Producer> {
                     "the master (its TPDO for RPDO {} of slave `{}`)",
                     pdo.number, node.name
                 ),
-                &slave.spot,
+                cob_id_spot(slave.rpdo.get(&pdo.number), pdo, &slave.spot),
                 Some((node.name.clone(), pdo.number)),
             ));
         }
@@ -242,16 +242,21 @@ fn node_services(out: &mut Vec<Producer>, id: u8, who: &str, emcy: u32, spot: &S
     push((0x700 + id32, false), "heartbeat/boot-up");
 }
 
-fn pdo_producer(
-    pdo: &Pdo,
-    who: String,
-    slave_spot: &Spot,
-    mirrors: Option<(String, u16)>,
-) -> Producer {
+/// Where a PDO's COB-ID is written: its `cob_id:`, else its section,
+/// else the slave (a device file's default PDO).
+fn cob_id_spot(section: Option<&PdoSection>, pdo: &Pdo, slave: &Spot) -> Spot {
+    section
+        .and_then(|s| s.cob_id.as_ref().map(|c| &c.spot))
+        .or(pdo.spot.as_ref())
+        .unwrap_or(slave)
+        .clone()
+}
+
+fn pdo_producer(pdo: &Pdo, who: String, spot: Spot, mirrors: Option<(String, u16)>) -> Producer {
     Producer {
         id: can_id(pdo.cob_id),
         who,
-        spot: pdo.spot.clone().unwrap_or_else(|| slave_spot.clone()),
+        spot,
         pdo: true,
         written: pdo.spot.is_some(),
         mirrors,

@@ -51,8 +51,8 @@ pub struct BusLoad {
     pub bit_rate: u32,
     /// Every counted source, in the bus's order.
     pub items: Vec<LoadItem>,
-    /// Sources whose rate cannot be known here, each saying why.
-    pub not_counted: Vec<String>,
+    /// Sources whose rate cannot be known here: what, and why.
+    pub not_counted: Vec<(String, &'static str)>,
 }
 
 impl BusLoad {
@@ -98,8 +98,16 @@ impl fmt::Display for BusLoad {
                 item.what, item.frames_per_second, item.bits_per_frame
             )?;
         }
-        for what in &self.not_counted {
-            writeln!(f, "  not counted: {what}")?;
+        let mut reasons: Vec<&str> = self.not_counted.iter().map(|(_, why)| *why).collect();
+        reasons.dedup();
+        for reason in reasons {
+            let whats: Vec<&str> = self
+                .not_counted
+                .iter()
+                .filter(|(_, why)| *why == reason)
+                .map(|(what, _)| what.as_str())
+                .collect();
+            writeln!(f, "  not counted, {reason}: {}", whats.join(", "))?;
         }
         Ok(())
     }
@@ -131,7 +139,7 @@ pub fn bus_load(bus: &Bus, configured: &Configured) -> BusLoad {
             pdo_load(&mut load, what, pdo, sync);
         }
         for pdo in &node.rpdos {
-            let what = format!("RPDO {} of {} (sent by the master)", pdo.number, node.name);
+            let what = format!("RPDO {} of {} (the master sends it)", pdo.number, node.name);
             pdo_load(&mut load, what, pdo, sync);
         }
         if node.heartbeat_producer > 0 {
@@ -174,19 +182,19 @@ fn pdo_load(load: &mut BusLoad, what: String, pdo: &Pdo, sync: Option<f64>) {
             Some(rate) => rate / f64::from(t.max(1)),
             None => {
                 load.not_counted
-                    .push(format!("{what}: synchronous, but no SYNC is sent"));
+                    .push((what, "synchronous, but no SYNC is sent"));
                 return;
             }
         },
         252 | 253 => {
-            load.not_counted
-                .push(format!("{what}: sent on remote request only"));
+            load.not_counted.push((what, "sent on remote request only"));
             return;
         }
         _ if pdo.event_timer > 0 => 1000.0 / f64::from(pdo.event_timer),
         _ => {
-            load.not_counted.push(format!(
-                "{what}: event-driven without an event timer (sent when the application says)"
+            load.not_counted.push((
+                what,
+                "event-driven without an event timer (sent when the application says)",
             ));
             return;
         }

@@ -241,6 +241,13 @@ fn sdo_write(slave: &SlaveSection, node: &Node, item: &SdoItem, report: &mut Rep
         PdoDirection::Tpdo => (&slave.tpdo, &node.tpdos, "tpdo"),
     };
     let pdo = pdos.iter().find(|p| p.number == n);
+    let show = |v: i128| {
+        if (mapping && item.sub_index > 0) || item.sub_index == 1 {
+            format!("0x{v:08X}")
+        } else {
+            v.to_string()
+        }
+    };
     let what = format!(
         "this SDO write sets 0x{:04X} sub {} ({pdo_name}'s {}) to {}",
         item.index,
@@ -250,7 +257,7 @@ fn sdo_write(slave: &SlaveSection, node: &Node, item: &SdoItem, report: &mut Rep
         } else {
             "communication parameter"
         },
-        item.value
+        show(item.value)
     );
     let sets = sections.get(&n).map_or(Sets::Nothing, |s| {
         section_sets(s, direction, mapping, item.sub_index, pdo, &slave.device)
@@ -268,7 +275,7 @@ fn sdo_write(slave: &SlaveSection, node: &Node, item: &SdoItem, report: &mut Rep
             );
         }
         Sets::Value(spot, set) => {
-            let set = set.map_or_else(String::new, |v| format!(" to {v}"));
+            let set = set.map_or_else(String::new, |v| format!(" to {}", show(v)));
             report.error(
                 "net::sdo-pdo-conflict",
                 &item.spot,
@@ -295,8 +302,9 @@ fn sdo_write(slave: &SlaveSection, node: &Node, item: &SdoItem, report: &mut Rep
             let severity_error = mapping || item.sub_index == 1;
             let message = format!(
                 "{what}, behind the `{key}` section: master.dcf and the generated network \
-                 follow the bus file's sections and the device file ({default} here), not \
-                 the SDO list"
+                 follow the bus file's sections and the device file ({} here), not \
+                 the SDO list",
+                show(default)
             );
             let notes = vec![format!(
                 "write it in the section instead: `{key}: {{ {n}: {{ ... }} }}`"

@@ -144,7 +144,7 @@ fn a_pdo_on_another_nodes_cob_id_collides() {
     tpdo.cob_id = Some(at(CobIdSetting::Value(0x183), 51, "a.tpdo.1.cob_id"));
     a.tpdo.insert(1, tpdo);
     let found = codes(&bus(vec![a, slave("b", 3, 20)]));
-    assert_eq!(found, [("net::cob-id-collision", "a.tpdo.1".into())]);
+    assert_eq!(found, [("net::cob-id-collision", "a.tpdo.1.cob_id".into())]);
 }
 
 #[test]
@@ -172,7 +172,7 @@ fn restricted_cob_ids_are_warned() {
     a.tpdo.insert(1, tpdo);
     assert_eq!(
         codes(&bus(vec![a])),
-        [("net::cob-id-restricted", "a.tpdo.1".into())]
+        [("net::cob-id-restricted", "a.tpdo.1.cob_id".into())]
     );
 }
 
