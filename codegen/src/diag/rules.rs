@@ -160,6 +160,52 @@ pub const RULES: &[Rule] = &[
         "an input file above the size limit (--max-input-size)",
     ),
     rule(
+        "net::bad-value",
+        "a bus file value of the wrong type or outside its key's range",
+    ),
+    rule(
+        "net::device-file",
+        "a slave's device file that cannot be read",
+    ),
+    rule(
+        "net::duplicate-key",
+        "a key given twice in one map of a bus file (the later wins)",
+    ),
+    rule(
+        "net::duplicate-node",
+        "a slave name given twice in a bus file",
+    ),
+    rule(
+        "net::missing-key",
+        "a key dcfgen needs (`master:`, a slave's `dcf`, an item's `index`)",
+    ),
+    rule("net::node-id", "a node id outside 1..=127 in a bus file"),
+    rule(
+        "net::pdo-number",
+        "a PDO number outside 1..=512 in a bus file",
+    ),
+    rule(
+        "net::syntax",
+        "bus file YAML syntax, not UTF-8, over a limit, or not a map",
+    ),
+    rule(
+        "net::too-large",
+        "more than 127 slaves, or `defaults:` expanded beyond the limit",
+    ),
+    rule(
+        "net::truncated",
+        "a fraction where dcfgen needs an integer (it cuts it)",
+    ),
+    rule(
+        "net::truthy-text",
+        "text where dcfgen reads a boolean (any non-empty text is true)",
+    ),
+    rule(
+        "net::unknown-key",
+        "an unknown key in a PDO, mapping or sdo item (dcfgen ignores it)",
+    ),
+    rule("net::unused-defaults", "`defaults:` without `nodes:`"),
+    rule(
         "table::array-type",
         "an ARRAY whose subs do not share one type",
     ),
@@ -366,7 +412,7 @@ mod tests {
                     let Some((area, name)) = word.split_once("::") else {
                         continue;
                     };
-                    let is_code = ["build", "eds", "gen", "input", "table"].contains(&area)
+                    let is_code = ["build", "eds", "gen", "input", "net", "table"].contains(&area)
                         && !name.is_empty()
                         && name
                             .bytes()
