@@ -38,12 +38,13 @@ pub(crate) struct SlaveSource<'n> {
     pub entries: Vec<Entry<'n>>,
 }
 
-/// Splits the top level into its sections and expands `nodes:`.
-pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Layout<'n> {
+/// Splits the top level into its sections and expands `nodes:`; `None`
+/// (with an error) when the top level is not a map.
+pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Option<Layout<'n>> {
     let mut layout = Layout::default();
     let pairs = match &root.value {
         Value::Map(pairs) => pairs,
-        Value::Null => return layout,
+        Value::Null => return Some(layout),
         other => {
             ctx.error(
                 "net::syntax",
@@ -54,7 +55,7 @@ pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Layout<'n> {
                     other.kind()
                 ),
             );
-            return layout;
+            return None;
         }
     };
     let mut defaults: Option<Entry<'n>> = None;
@@ -137,7 +138,7 @@ pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Layout<'n> {
         );
         layout.slaves.truncate(MAX_SLAVES);
     }
-    layout
+    Some(layout)
 }
 
 /// Adds a slave section, unless its name is taken (an error: dcfgen would

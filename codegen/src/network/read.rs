@@ -74,9 +74,9 @@ impl<'o> Devices<'o> {
     }
 }
 
-/// Reads the whole tree.
-pub(crate) fn bus(ctx: &mut Ctx, root: &Node, file: &Path, devices: &mut Devices) -> Bus {
-    let layout = expand::layout(ctx, root);
+/// Reads the whole tree; `None` when its top level is not a map.
+pub(crate) fn bus(ctx: &mut Ctx, root: &Node, file: &Path, devices: &mut Devices) -> Option<Bus> {
+    let layout = expand::layout(ctx, root)?;
     let mut extra_keys = Vec::new();
     let options = match &layout.options {
         Some(e) => bus_options(ctx, e, &mut extra_keys),
@@ -104,13 +104,13 @@ pub(crate) fn bus(ctx: &mut Ctx, root: &Node, file: &Path, devices: &mut Devices
         .iter()
         .filter_map(|s| slave(ctx, s, devices, &mut extra_keys))
         .collect();
-    Bus {
+    Some(Bus {
         file: file.to_path_buf(),
         options,
         master,
         slaves,
         extra_keys,
-    }
+    })
 }
 
 fn extra(section: &str, e: &Entry) -> ExtraKey {
