@@ -147,13 +147,22 @@ fn device_file_that_cannot_be_read() {
             && all[0].contains("nothing.eds"),
         "{all:#?}"
     );
+    assert!(
+        all[0].ends_with(": No such file or directory (os error 2)"),
+        "{all:#?}"
+    );
     assert!(loaded.bus.unwrap().slaves.is_empty());
-    // The device file's own error names the device file.
+    // That error stands for the device file's.
+    assert_eq!(loaded.diagnostics.len(), 1);
+    // A device file's own diagnostics name the device file.
+    let loaded = read(&format!(
+        "{MASTER}a:\n  dcf: ../malformed/bad_access_type.eds\n  node_id: 2\n"
+    ));
     assert!(
         loaded
             .diagnostics
             .iter()
-            .any(|d| d.file.ends_with("nothing.eds") && d.severity == Severity::Error)
+            .any(|d| d.file.ends_with("bad_access_type.eds") && d.location.line.is_some())
     );
 }
 
