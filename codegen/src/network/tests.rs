@@ -190,6 +190,10 @@ fn node_ids_and_ranges() {
         one_error(&slave("node_id: abc")),
         "5 net::bad-value a.node_id: an integer is needed here, not the text \"abc\""
     );
+    // Python's int() of a boolean.
+    let loaded = read(&slave("node_id: true"));
+    assert!(diags(&loaded).is_empty());
+    assert_eq!(loaded.bus.unwrap().slaves[0].effective_node_id(), Some(1));
     assert_eq!(
         one_error(&slave("guard_time: [1]")),
         "5 net::bad-value a.guard_time: an integer is needed here, not a list"

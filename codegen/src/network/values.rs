@@ -129,10 +129,12 @@ impl Ctx<'_> {
     }
 
     /// An integer as Python's `int()` reads it: a YAML integer, a decimal
-    /// number in quotes, a decimal fraction (cut, with a warning).
+    /// number in quotes, a boolean (1 or 0), a decimal fraction (cut, with
+    /// a warning).
     pub fn integer(&mut self, node: &Node, key: &str) -> Option<i128> {
         match &node.value {
             Value::Int(i) => Some(*i),
+            Value::Bool(b) => Some(i128::from(*b)),
             Value::Float(f) if f.is_finite() && f.abs() < 1e30 => {
                 let cut = f.trunc();
                 if cut != *f {
@@ -253,10 +255,7 @@ impl Ctx<'_> {
     /// A flag dcfgen reads with `int()` (the master's `start` keys):
     /// `true`/`false` or an integer (0 is false).
     pub fn int_flag(&mut self, node: &Node, key: &str) -> Option<bool> {
-        match &node.value {
-            Value::Bool(b) => Some(*b),
-            _ => self.integer(node, key).map(|i| i != 0),
-        }
+        self.integer(node, key).map(|i| i != 0)
     }
 
     /// A decimal number as Python's `float()` reads it, finite and not
