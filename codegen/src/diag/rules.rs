@@ -160,6 +160,10 @@ pub const RULES: &[Rule] = &[
         "an input file above the size limit (--max-input-size)",
     ),
     rule(
+        "net::auto-cob-id",
+        "a PDO with cob_id: auto when no 11-bit COB-ID is left (0x680–0x6DF used up)",
+    ),
+    rule(
         "net::bad-value",
         "a bus file value of the wrong type or outside its key's range",
     ),
@@ -176,10 +180,34 @@ pub const RULES: &[Rule] = &[
         "a slave name given twice in a bus file",
     ),
     rule(
+        "net::heartbeat-and-guarding",
+        "a node with both a heartbeat producer time and node guarding",
+    ),
+    rule(
+        "net::identity-differs",
+        "a bus file's revision or serial number that differs from the device file's",
+    ),
+    rule(
         "net::missing-key",
         "a key dcfgen needs (`master:`, a slave's `dcf`, an item's `index`)",
     ),
+    rule(
+        "net::missing-object",
+        "a bus file setting whose object the device file lacks (0x1012, 0x1016, 0x1017, 0x100C, 0x100D, 0x1029, 0x1F56, 0x1011)",
+    ),
+    rule(
+        "net::no-node-id",
+        "a slave without a node id, left out of the network",
+    ),
+    rule(
+        "net::no-such-pdo",
+        "an rpdo/tpdo number the device file has no PDO for",
+    ),
     rule("net::node-id", "a node id outside 1..=127 in a bus file"),
+    rule(
+        "net::not-writable",
+        "a configuration write to an entry that is not writable",
+    ),
     rule(
         "net::pdo-number",
         "a PDO number outside 1..=512 in a bus file",
@@ -204,7 +232,15 @@ pub const RULES: &[Rule] = &[
         "net::unknown-key",
         "an unknown key in a PDO, mapping or sdo item (dcfgen ignores it)",
     ),
+    rule(
+        "net::unknown-object",
+        "a write or mapping of an object or sub-object the device file lacks",
+    ),
     rule("net::unused-defaults", "`defaults:` without `nodes:`"),
+    rule(
+        "net::value-range",
+        "a configuration value that does not fit its entry's data type",
+    ),
     rule(
         "table::array-type",
         "an ARRAY whose subs do not share one type",

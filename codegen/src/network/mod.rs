@@ -4,11 +4,15 @@
 //! DCFs.
 
 pub mod config;
+mod configure;
 mod expand;
+pub use configure::configure;
 pub mod model;
 mod pdo;
+mod pdo_config;
 mod read;
 mod values;
+mod view;
 mod yaml;
 
 #[cfg(test)]
