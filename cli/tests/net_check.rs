@@ -18,7 +18,7 @@ fn net_check_exit_codes_and_levels() {
     let (code, stdout, _) = run(&["net", "check", &fixture("cob-id-collision")]);
     assert_eq!(code, 1, "{stdout}");
     assert!(stdout.contains("error[net::cob-id-collision]"), "{stdout}");
-    assert!(stdout.contains("cob-id-collision/bus.yml:13:"), "{stdout}");
+    assert!(stdout.contains("cob-id-collision/bus.yml:14:"), "{stdout}");
     assert!(stdout.contains("bus load at 1000 kbit/s"), "{stdout}");
     assert!(stdout.contains("2 nodes, 2 errors, 0 warnings"), "{stdout}");
 

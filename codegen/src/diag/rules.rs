@@ -164,6 +164,10 @@ pub const RULES: &[Rule] = &[
         "a PDO with cob_id: auto when no 11-bit COB-ID is left (0x680–0x6DF used up)",
     ),
     rule(
+        "net::bad-value",
+        "a bus file value of the wrong type or outside its key's range",
+    ),
+    rule(
         "net::bus-load",
         "an estimated bus load above the limit (--max-bus-load)",
     ),
@@ -171,6 +175,18 @@ pub const RULES: &[Rule] = &[
     rule(
         "net::cob-id-restricted",
         "a PDO COB-ID in a range CiA 301 restricts",
+    ),
+    rule(
+        "net::device-file",
+        "a slave's device file that cannot be read",
+    ),
+    rule(
+        "net::duplicate-key",
+        "a key given twice in one map of a bus file (the later wins)",
+    ),
+    rule(
+        "net::duplicate-node",
+        "a slave name given twice in a bus file",
     ),
     rule(
         "net::heartbeat-and-guarding",
@@ -189,6 +205,10 @@ pub const RULES: &[Rule] = &[
         "a bus file's revision or serial number that differs from the device file's",
     ),
     rule(
+        "net::missing-key",
+        "a key dcfgen needs (`master:`, a slave's `dcf`, an item's `index`)",
+    ),
+    rule(
         "net::missing-object",
         "a bus file setting whose object the device file lacks (0x1012, 0x1016, 0x1017, 0x100C, 0x100D, 0x1029, 0x1F56, 0x1011)",
     ),
@@ -200,7 +220,7 @@ pub const RULES: &[Rule] = &[
         "net::no-such-pdo",
         "an rpdo/tpdo number the device file has no PDO for",
     ),
-    rule("net::node-id", "a node id outside 1..=127"),
+    rule("net::node-id", "a node id outside 1..=127 in a bus file"),
     rule("net::node-id-collision", "two nodes with one node id"),
     rule(
         "net::not-writable",
@@ -215,6 +235,10 @@ pub const RULES: &[Rule] = &[
         "a bus file's PDO mapping of an object that is not PDO-mappable",
     ),
     rule(
+        "net::pdo-number",
+        "a PDO number outside 1..=512 in a bus file",
+    ),
+    rule(
         "net::pdo-too-long",
         "a bus file's PDO mapping of more than 64 bits",
     ),
@@ -225,9 +249,30 @@ pub const RULES: &[Rule] = &[
         "an `sdo:` write to a PDO parameter that the PDO sections set or do not see",
     ),
     rule(
+        "net::syntax",
+        "bus file YAML syntax, not UTF-8, over a limit, or not a map",
+    ),
+    rule(
+        "net::too-large",
+        "more than 127 slaves, or `defaults:` expanded beyond the limit",
+    ),
+    rule(
+        "net::truncated",
+        "a fraction where dcfgen needs an integer (it cuts it)",
+    ),
+    rule(
+        "net::truthy-text",
+        "text where dcfgen reads a boolean (any non-empty text is true)",
+    ),
+    rule(
+        "net::unknown-key",
+        "an unknown key in a PDO, mapping or sdo item (dcfgen ignores it)",
+    ),
+    rule(
         "net::unknown-object",
         "a write or mapping of an object or sub-object the device file lacks",
     ),
+    rule("net::unused-defaults", "`defaults:` without `nodes:`"),
     rule(
         "net::value-range",
         "a configuration value that does not fit its entry's data type",

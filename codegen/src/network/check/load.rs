@@ -247,10 +247,15 @@ pub(super) fn check(net: &Net, limits: &super::CheckLimits, report: &mut Report)
         &spot,
         format!(
             "the estimated bus load is {percent:.1} % of {} kbit/s ({:.1} frames/s), above \
-             the limit of {} %",
+             the limit of {} %{}",
             load.bit_rate / 1000,
             load.frames_per_second(),
-            limits.max_bus_load_percent
+            limits.max_bus_load_percent,
+            if percent > 100.0 {
+                ": more than the bus can carry, frames are late or lost"
+            } else {
+                ""
+            }
         ),
         notes,
     );
