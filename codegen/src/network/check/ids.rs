@@ -235,7 +235,14 @@ fn node_services(out: &mut Vec<Producer>, id: u8, who: &str, emcy: u32, spot: &S
         });
     };
     if emcy & 0x8000_0000 == 0 {
-        push(can_id(emcy), "EMCY");
+        // A device file without a value for 0x1014 uses the pre-defined
+        // COB-ID (0x000 is NMT's, never an EMCY's).
+        let cob = if emcy & 0x1FFF_FFFF == 0 {
+            0x80 + id32
+        } else {
+            emcy
+        };
+        push(can_id(cob), "EMCY");
     }
     push((0x580 + id32, false), "the SDO response");
     push((0x600 + id32, false), "the SDO request");
