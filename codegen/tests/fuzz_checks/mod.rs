@@ -105,6 +105,15 @@ pub fn bus_reader(data: &[u8]) {
             assert!((1..=512).contains(number), "PDO {number}");
         }
     }
+    // The configuration and the whole-bus check return on any bus, and
+    // each check diagnostic names the bus file.
+    let (configured, _) = eds2rust::network::configure(bus);
+    let limits = eds2rust::network::check::CheckLimits::default();
+    let checked = eds2rust::network::check::check(bus, &configured, &limits);
+    for d in checked.iter() {
+        assert_eq!(d.file, BUS_NAME, "{d}");
+    }
+    let _ = eds2rust::network::check::bus_load(bus, &configured).to_string();
 }
 
 /// Paths an attacker would name in `base:`; each fuzz input is tried as a

@@ -14,7 +14,7 @@ use super::{Net, Report, device_int};
 use crate::network::config::Node;
 use crate::network::model::{SlaveSection, Spot};
 
-pub(super) fn check(net: &Net, report: &mut Report) {
+pub(super) fn check(net: &Net, report: &mut Report<'_>) {
     master_consumes(net, report);
     slaves_consume_master(net, report);
     for (node, slave) in net.nodes() {
@@ -70,7 +70,7 @@ fn first_spot(candidates: &[Option<&Spot>], fallback: &Spot) -> Spot {
 }
 
 /// The master's consumer entries for the slaves' heartbeats.
-fn master_consumes(net: &Net, report: &mut Report) {
+fn master_consumes(net: &Net, report: &mut Report<'_>) {
     if !net.bus.master.heartbeat_consumer {
         return;
     }
@@ -106,7 +106,7 @@ fn master_consumes(net: &Net, report: &mut Report) {
 }
 
 /// The slaves' consumer entries for the master's heartbeat.
-fn slaves_consume_master(net: &Net, report: &mut Report) {
+fn slaves_consume_master(net: &Net, report: &mut Report<'_>) {
     let master = &net.bus.master;
     let producer = master.heartbeat_producer;
     let mut timing_reported = false;
@@ -155,7 +155,7 @@ fn slaves_consume_master(net: &Net, report: &mut Report) {
 
 /// The consumer entries (0x1016) a slave's device file sets by itself,
 /// unless the configuration rewrites them.
-fn device_consumers(net: &Net, node: &Node, slave: &SlaveSection, report: &mut Report) {
+fn device_consumers(net: &Net, node: &Node, slave: &SlaveSection, report: &mut Report<'_>) {
     let Some(object) = slave.device.objects.get(&0x1016) else {
         return;
     };

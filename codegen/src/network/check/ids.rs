@@ -51,7 +51,7 @@ struct Producer {
     time: bool,
 }
 
-pub(super) fn check(net: &Net, report: &mut Report) {
+pub(super) fn check(net: &Net, report: &mut Report<'_>) {
     node_ids(net, report);
     let producers = producers(net);
     collisions(&producers, report);
@@ -59,7 +59,7 @@ pub(super) fn check(net: &Net, report: &mut Report) {
 }
 
 /// `net::node-id`, `net::node-id-collision`.
-fn node_ids(net: &Net, report: &mut Report) {
+fn node_ids(net: &Net, report: &mut Report<'_>) {
     let master = &net.bus.master;
     let master_written = master.spots.contains_key("node_id");
     if net.master_id().is_none() {
@@ -281,7 +281,7 @@ fn show(id: (u32, bool)) -> String {
 /// `net::cob-id-collision`: each producer that shares its COB-ID with an
 /// earlier one, reported at the PDO of the pair (its COB-ID is what can
 /// be changed).
-fn collisions(producers: &[Producer], report: &mut Report) {
+fn collisions(producers: &[Producer], report: &mut Report<'_>) {
     for (j, later) in producers.iter().enumerate() {
         let Some(first) = producers[..j]
             .iter()
@@ -339,7 +339,7 @@ fn collisions(producers: &[Producer], report: &mut Report) {
 
 /// `net::cob-id-restricted`: a PDO on an 11-bit CAN-ID that CiA 301
 /// restricts.
-fn restricted(producers: &[Producer], report: &mut Report) {
+fn restricted(producers: &[Producer], report: &mut Report<'_>) {
     for p in producers.iter().filter(|p| p.pdo && !p.id.1) {
         let id = p.id.0;
         let Some(&(low, high, what)) = RESTRICTED.iter().find(|(l, h, _)| (*l..=*h).contains(&id))

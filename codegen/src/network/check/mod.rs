@@ -21,7 +21,7 @@ mod pdo;
 #[cfg(test)]
 mod tests;
 
-use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
+use crate::diag::{Diagnostics, Severity};
 
 use super::config::{Configured, Node};
 use super::model::{Bus, SlaveSection, Spot};
@@ -49,10 +49,11 @@ impl Default for CheckLimits {
 }
 
 /// Checks the whole bus: every `net::` rule. The diagnostics point into
-/// the bus file (its text is read again, best effort, to show the lines).
+/// the bus file by line and key; to show the lines, render them together
+/// with the reader's diagnostics (which hold the bus file's text) after
+/// [`Diagnostics::span_lines`].
 pub fn check(bus: &Bus, configured: &Configured, limits: &CheckLimits) -> Diagnostics {
-    let text = std::fs::read_to_string(&bus.file).ok();
-    let mut report = Report::new(bus, text.as_deref());
+    let mut report = Report::new(bus);
     let net = Net { bus, configured };
     ids::check(&net, &mut report);
     pdo::check(&net, &mut report);
@@ -119,23 +120,16 @@ fn device_int(device: &crate::ir::Device, index: u16, sub: u8, node_id: u8) -> O
 }
 
 /// Collects the diagnostics of the check, all in the bus file.
-struct Report<'t> {
-    file: String,
-    text: Option<&'t str>,
+struct Report<'a> {
+    file: &'a std::path::Path,
     diagnostics: Diagnostics,
 }
 
-impl<'t> Report<'t> {
-    fn new(bus: &Bus, text: Option<&'t str>) -> Self {
-        let file = bus.file.display().to_string();
-        let mut diagnostics = Diagnostics::new();
-        if let Some(text) = text {
-            diagnostics.add_source(&file, text);
-        }
+impl<'a> Report<'a> {
+    fn new(bus: &'a Bus) -> Self {
         Report {
-            file,
-            text,
-            diagnostics,
+            file: &bus.file,
+            diagnostics: Diagnostics::new(),
         }
     }
 
@@ -148,22 +142,9 @@ impl<'t> Report<'t> {
         message: String,
         notes: Vec<String>,
     ) {
-        let line = (spot.line > 0).then_some(spot.line);
-        self.diagnostics.push(Diagnostic {
-            severity,
-            code,
-            file: self.file.clone(),
-            location: Location {
-                line,
-                span: line
-                    .and(self.text)
-                    .map(|t| crate::diag::line_span(t, spot.line)),
-                section: None,
-                key: (!spot.key.is_empty()).then(|| spot.key.clone()),
-            },
-            message,
-            notes,
-        });
+        let mut diagnostic = spot.diagnostic(self.file, severity, code, message);
+        diagnostic.notes = notes;
+        self.diagnostics.push(diagnostic);
     }
 
     fn error(&mut self, code: &'static str, spot: &Spot, message: String, notes: Vec<String>) {

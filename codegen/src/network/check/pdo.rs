@@ -22,7 +22,7 @@ use crate::ir::{DataType, Device, PdoDirection};
 use crate::network::config::{Node, Pdo};
 use crate::network::model::{MappingItem, PdoSection, SdoItem, SlaveSection, Spot};
 
-pub(super) fn check(net: &Net, report: &mut Report) {
+pub(super) fn check(net: &Net, report: &mut Report<'_>) {
     for (i, slave) in net.bus.slaves.iter().enumerate() {
         mappings(slave, report);
         let Some(node) = net.node_of(i) else { continue };
@@ -76,7 +76,7 @@ fn resolve(device: &Device, item: &MappingItem) -> Option<MappedObject> {
 /// `net::pdo-mapping`, `net::pdo-direction`, `net::pdo-too-long` for the
 /// mappings written in the bus file (the device file's own mappings are
 /// the device reader's to check).
-fn mappings(slave: &SlaveSection, report: &mut Report) {
+fn mappings(slave: &SlaveSection, report: &mut Report<'_>) {
     let device = &slave.device;
     for (direction, sections) in sections(slave) {
         for (&n, section) in sections {
@@ -226,7 +226,7 @@ fn same(mapping: bool, sub: u8, written: i128, set: i128) -> bool {
 }
 
 /// `net::sdo-pdo-conflict`: one `sdo:` write to a PDO parameter object.
-fn sdo_write(slave: &SlaveSection, node: &Node, item: &SdoItem, report: &mut Report) {
+fn sdo_write(slave: &SlaveSection, node: &Node, item: &SdoItem, report: &mut Report<'_>) {
     let (direction, mapping, first) = match item.index {
         0x1400..=0x15FF => (PdoDirection::Rpdo, false, 0x1400),
         0x1600..=0x17FF => (PdoDirection::Rpdo, true, 0x1600),
@@ -319,7 +319,7 @@ fn sdo_write(slave: &SlaveSection, node: &Node, item: &SdoItem, report: &mut Rep
 }
 
 /// `net::pdo-unproduced`, `net::pdo-unconsumed`.
-fn never_sent(net: &Net, slave: &SlaveSection, node: &Node, report: &mut Report) {
+fn never_sent(net: &Net, slave: &SlaveSection, node: &Node, report: &mut Report<'_>) {
     let no_sync = net.bus.master.sync_period == 0;
     for (direction, sections) in sections(slave) {
         let pdos = match direction {
