@@ -10,7 +10,7 @@
 //! slave with `heartbeat_consumer: true` the master's. A consumer time not
 //! above its producer time signals a lost heartbeat although none was.
 
-use super::{Net, Report, device_int};
+use super::context::{Net, Report, device_int};
 use crate::network::config::Node;
 use crate::network::model::{SlaveSection, Spot};
 

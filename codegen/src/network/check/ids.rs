@@ -3,7 +3,7 @@
 
 use std::collections::BTreeMap;
 
-use super::{Net, Report};
+use super::context::{Net, Report};
 use crate::network::config::Pdo;
 use crate::network::model::{PdoSection, Spot};
 

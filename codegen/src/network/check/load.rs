@@ -13,7 +13,7 @@
 
 use std::fmt;
 
-use super::{Net, Report};
+use super::context::{Net, Report};
 use crate::network::config::{Configured, Pdo};
 use crate::network::model::Bus;
 
@@ -213,7 +213,7 @@ fn pdo_load(load: &mut BusLoad, what: String, pdo: &Pdo, sync: Option<f64>) {
 }
 
 /// `net::bus-load`: the estimate above the limit.
-pub(super) fn check(net: &Net, limits: &super::CheckLimits, report: &mut Report<'_>) {
+pub(super) fn check(net: &Net, limits: &super::context::CheckLimits, report: &mut Report<'_>) {
     let load = bus_load(net.bus, net.configured);
     let percent = load.percent();
     if percent <= limits.max_bus_load_percent {

@@ -16,7 +16,7 @@
 
 use std::collections::BTreeMap;
 
-use super::{Net, Report, device_int};
+use super::context::{Net, Report, device_int};
 use crate::ir::pdo::{MappedObject, MappingProblem, check_entry, mappable_bits};
 use crate::ir::{DataType, Device, PdoDirection};
 use crate::network::config::{Node, Pdo};

@@ -5,6 +5,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::*;
+use crate::diag::Severity;
 use crate::input::{Options, read_device};
 use crate::network::configure;
 use crate::network::model::*;
