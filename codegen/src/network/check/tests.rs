@@ -329,3 +329,35 @@ fn bus_load_counts_sync_pdos_and_heartbeats() {
         ["net::bus-load"]
     );
 }
+
+#[test]
+fn pdos_on_sync_time_emcy_and_lss_collide() {
+    for (cob, with) in [
+        (0x080, "SYNC (the master)"),
+        (0x100, "TIME"),
+        (0x083, "EMCY of slave `b` (node 3)"),
+        (0x7E5, "LSS (the master's requests)"),
+    ] {
+        let mut a = slave("a", 2, 10);
+        let mut tpdo = section(50, "a.tpdo.1");
+        tpdo.cob_id = Some(at(CobIdSetting::Value(cob), 51, "a.tpdo.1.cob_id"));
+        a.tpdo.insert(1, tpdo);
+        let b = bus(vec![slave("b", 3, 20), a]);
+        let (configured, _) = configure(&b);
+        let d = check(&b, &configured, &CheckLimits::default());
+        let collisions: Vec<_> = d
+            .iter()
+            .filter(|d| d.code == "net::cob-id-collision")
+            .collect();
+        assert_eq!(collisions.len(), 1, "0x{cob:03X}: {d}");
+        assert!(
+            collisions[0].message.contains(with),
+            "{}",
+            collisions[0].message
+        );
+        assert_eq!(
+            collisions[0].location.key.as_deref(),
+            Some("a.tpdo.1.cob_id")
+        );
+    }
+}
