@@ -1,12 +1,13 @@
 //! The top level of a bus file: `options:`, `master:`, the flat slave
 //! sections, and ros2_canopen's `defaults:` + `nodes:`, expanded as
-//! ros2_canopen expands them before it calls dcfgen: each entry of
-//! `nodes:` becomes a slave with the keys of `defaults:` put over its own
-//! (a dict update: the defaults win, a nested map such as `tpdo` is
-//! replaced whole), and the slaves are then ordered by name (ros2_canopen
-//! writes the expanded file with its keys sorted, and dcfgen numbers the
-//! master's PDOs in that order). A file without `nodes:` is dcfgen's own
-//! input: its slaves stay in file order. Keys starting with `.` are
+//! ros2_canopen expands them before it calls dcfgen (its `cogen` step):
+//! each entry of `nodes:` becomes a slave with the keys of `defaults:` put
+//! over its own (the defaults win; a nested map such as `tpdo` is replaced
+//! whole), the expanded file keeps only `options:`, `master:` and the nodes
+//! (a flat slave section beside `nodes:` is dropped, with a warning), and
+//! its keys are sorted, so the slaves are ordered by name (dcfgen numbers
+//! the master's PDOs in that order). A file without `nodes:` is dcfgen's
+//! own input: its slaves stay in file order. Keys starting with `.` are
 //! ignored, as dcfgen ignores them.
 
 use super::values::{Ctx, Entry, join};
@@ -105,12 +106,34 @@ pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Option<Layout<'n>> {
             );
         }
     }
-    let sorted = nodes.is_some();
-    for entry in flat {
-        if let Some(slave) = flat_slave(ctx, entry) {
-            layout.slaves.push(slave);
+    match &nodes {
+        Some(nodes) => {
+            for entry in flat {
+                ctx.warn(
+                    "net::dropped-section",
+                    entry.key_node.at,
+                    &entry.path,
+                    format!(
+                        "a file with `nodes:` (line {}) is expanded by ros2_canopen, which keeps \
+                         only options:, master: and the nodes: this section is not on the bus",
+                        nodes.key_node.at.line
+                    ),
+                );
+                ctx.note(format!(
+                    "move it into `nodes:` to put {} on the bus",
+                    entry.key
+                ));
+            }
+        }
+        None => {
+            for entry in flat {
+                if let Some(slave) = flat_slave(ctx, entry) {
+                    layout.slaves.push(slave);
+                }
+            }
         }
     }
+    let sorted = nodes.is_some();
     match (nodes, defaults) {
         (Some(nodes), defaults) => expand(ctx, &mut layout.slaves, &nodes, defaults.as_ref()),
         (None, Some(defaults)) => ctx.warn(
@@ -198,18 +221,6 @@ fn expand<'n>(
         return;
     }
     for node in node_entries {
-        if let Some(first) = slaves.iter().find(|s| s.name == node.key) {
-            let line = first.key_node.at.line;
-            ctx.error(
-                "net::duplicate-node",
-                node.key_node.at,
-                &node.key,
-                format!(
-                    "a slave of this name is given already (line {line}); this node is not read"
-                ),
-            );
-            continue;
-        }
         let Some(mut entries) = ctx.entries(node.value, &node.key) else {
             continue;
         };
@@ -261,6 +272,9 @@ fn node_list<'n>(ctx: &mut Ctx, nodes: &Entry<'n>) -> Option<Vec<Entry<'n>>> {
             );
             continue;
         };
+        if key.starts_with('.') {
+            continue;
+        }
         add_slave(
             ctx,
             &mut out,
