@@ -174,6 +174,17 @@ fn device_file_that_cannot_be_read() {
 }
 
 #[test]
+fn a_yaml_table_as_device_file() {
+    let loaded = read(&format!(
+        "{MASTER}linak:\n  dcf: ../../../../eds/linak_techline.yaml\n  node_id: 32\n"
+    ));
+    assert!(!loaded.diagnostics.has_errors(), "{}", loaded.diagnostics.render());
+    let bus = loaded.bus.unwrap();
+    assert!(bus.slaves[0].device.objects.contains_key(&0x2000));
+    assert!(loaded.files[0].ends_with("eds/linak_techline.yaml"));
+}
+
+#[test]
 fn node_id_from_a_dcf() {
     let loaded = read(&format!("{MASTER}a:\n  dcf: ../diff/06_dcf/old.dcf\n"));
     assert!(
