@@ -10,6 +10,8 @@
 //! own input: its slaves stay in file order. Keys starting with `.` are
 //! ignored, as dcfgen ignores them.
 
+use std::collections::HashMap;
+
 use super::values::{Ctx, Entry, join};
 use super::yaml::{Node, Value};
 
@@ -61,7 +63,7 @@ pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Option<Layout<'n>> {
     };
     let mut defaults: Option<Entry<'n>> = None;
     let mut nodes: Option<Entry<'n>> = None;
-    let mut flat: Vec<Entry<'n>> = Vec::new();
+    let mut flat = Slaves::default();
     for (key_node, value) in pairs {
         let Value::Str(key) = &key_node.value else {
             ctx.error(
@@ -108,7 +110,7 @@ pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Option<Layout<'n>> {
     }
     match &nodes {
         Some(nodes) => {
-            for entry in flat {
+            for entry in flat.list {
                 ctx.warn(
                     "net::dropped-section",
                     entry.key_node.at,
@@ -126,7 +128,7 @@ pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Option<Layout<'n>> {
             }
         }
         None => {
-            for entry in flat {
+            for entry in flat.list {
                 if let Some(slave) = flat_slave(ctx, entry) {
                     layout.slaves.push(slave);
                 }
@@ -166,9 +168,9 @@ pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Option<Layout<'n>> {
 
 /// Adds a slave section, unless its name is taken (an error: dcfgen would
 /// silently read only the later one).
-fn add_slave<'n>(ctx: &mut Ctx, slaves: &mut Vec<Entry<'n>>, entry: Entry<'n>) {
-    if let Some(first) = slaves.iter().find(|s| s.key == entry.key) {
-        let line = first.key_node.at.line;
+fn add_slave<'n>(ctx: &mut Ctx, slaves: &mut Slaves<'n>, entry: Entry<'n>) {
+    if let Some(&pos) = slaves.seen.get(&entry.key) {
+        let line = slaves.list[pos].key_node.at.line;
         ctx.error(
             "net::duplicate-node",
             entry.key_node.at,
@@ -177,7 +179,15 @@ fn add_slave<'n>(ctx: &mut Ctx, slaves: &mut Vec<Entry<'n>>, entry: Entry<'n>) {
         );
         return;
     }
-    slaves.push(entry);
+    slaves.seen.insert(entry.key.clone(), slaves.list.len());
+    slaves.list.push(entry);
+}
+
+/// Slave sections by name, in file order.
+#[derive(Default)]
+struct Slaves<'n> {
+    list: Vec<Entry<'n>>,
+    seen: HashMap<String, usize>,
 }
 
 fn flat_slave<'n>(ctx: &mut Ctx, entry: Entry<'n>) -> Option<SlaveSource<'n>> {
@@ -224,14 +234,22 @@ fn expand<'n>(
         let Some(mut entries) = ctx.entries(node.value, &node.key) else {
             continue;
         };
+        let mut own: HashMap<String, usize> = entries
+            .iter()
+            .enumerate()
+            .map(|(n, e)| (e.key.clone(), n))
+            .collect();
         for default in &default_entries {
             let merged = Entry {
                 path: join(&node.key, &default.key),
                 ..default.clone()
             };
-            match entries.iter_mut().find(|e| e.key == default.key) {
-                Some(own) => *own = merged,
-                None => entries.push(merged),
+            match own.get(&default.key) {
+                Some(&pos) => entries[pos] = merged,
+                None => {
+                    own.insert(default.key.clone(), entries.len());
+                    entries.push(merged);
+                }
             }
         }
         slaves.push(SlaveSource {
@@ -258,7 +276,7 @@ fn node_list<'n>(ctx: &mut Ctx, nodes: &Entry<'n>) -> Option<Vec<Entry<'n>>> {
             return None;
         }
     };
-    let mut out: Vec<Entry<'n>> = Vec::new();
+    let mut out = Slaves::default();
     for (key_node, value) in pairs {
         let Value::Str(key) = &key_node.value else {
             ctx.error(
@@ -286,5 +304,5 @@ fn node_list<'n>(ctx: &mut Ctx, nodes: &Entry<'n>) -> Option<Vec<Entry<'n>>> {
             },
         );
     }
-    Some(out)
+    Some(out.list)
 }

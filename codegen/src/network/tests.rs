@@ -178,7 +178,11 @@ fn a_yaml_table_as_device_file() {
     let loaded = read(&format!(
         "{MASTER}linak:\n  dcf: ../../../../eds/linak_techline.yaml\n  node_id: 32\n"
     ));
-    assert!(!loaded.diagnostics.has_errors(), "{}", loaded.diagnostics.render());
+    assert!(
+        !loaded.diagnostics.has_errors(),
+        "{}",
+        loaded.diagnostics.render()
+    );
     let bus = loaded.bus.unwrap();
     assert!(bus.slaves[0].device.objects.contains_key(&0x2000));
     assert!(loaded.files[0].ends_with("eds/linak_techline.yaml"));
@@ -429,6 +433,17 @@ fn hostile_inputs_do_not_panic() {
     for n in 0..100 {
         wide.push_str(&format!("  n{n}: {{}}\n"));
     }
+    // Quadratic work on many keys would show here.
+    let mut keys = String::from("master: {node_id: 1}\na:\n  dcf: base_ok.eds\n");
+    let mut sections = String::from("master: {node_id: 1}\n");
+    for n in 0..50_000 {
+        keys.push_str(&format!("  k{n}: 1\n"));
+        sections.push_str(&format!("s{n}: 1\n"));
+    }
+    let started = std::time::Instant::now();
+    assert_eq!(read(&keys).bus.unwrap().extra_keys.len(), 50_000);
+    assert!(read(&sections).diagnostics.has_errors());
+    assert!(started.elapsed().as_secs() < 20, "{:?}", started.elapsed());
     for (text, code) in [
         (deep.as_str(), "net::syntax"),
         (bomb, "net::syntax"),
