@@ -181,6 +181,10 @@ pub const RULES: &[Rule] = &[
         "a slave's device file that cannot be read",
     ),
     rule(
+        "net::dropped-section",
+        "a slave section beside `nodes:`, which ros2_canopen's expansion drops",
+    ),
+    rule(
         "net::duplicate-key",
         "a key given twice in one map of a bus file (the later wins)",
     ),

@@ -96,10 +96,17 @@ fn defaults_win_and_nodes_are_sorted() {
          heartbeat_producer: 7\n    tpdo:\n      1: {{enabled: false}}\n  a:\n    node_id: 2\n"
     );
     let loaded = read(&text);
-    assert!(diags(&loaded).is_empty(), "{:#?}", diags(&loaded));
+    assert_eq!(
+        diags(&loaded),
+        [
+            "3 net::dropped-section zeta: a file with `nodes:` (line 11) is expanded by \
+          ros2_canopen, which keeps only options:, master: and the nodes: this section is not \
+          on the bus"
+        ]
+    );
     let bus = loaded.bus.unwrap();
     let names: Vec<_> = bus.slaves.iter().map(|s| s.name.as_str()).collect();
-    assert_eq!(names, ["a", "b", "zeta"]);
+    assert_eq!(names, ["a", "b"]);
     let b = &bus.slaves[1];
     let hb = b.heartbeat_producer.as_ref().unwrap();
     assert_eq!(
@@ -164,6 +171,35 @@ fn device_file_that_cannot_be_read() {
             .iter()
             .any(|d| d.file.ends_with("bad_access_type.eds") && d.location.line.is_some())
     );
+}
+
+#[test]
+fn a_yaml_table_as_device_file() {
+    let loaded = read(&format!(
+        "{MASTER}linak:\n  dcf: ../../../../eds/linak_techline.yaml\n  node_id: 32\n"
+    ));
+    assert!(
+        !loaded.diagnostics.has_errors(),
+        "{}",
+        loaded.diagnostics.render()
+    );
+    let bus = loaded.bus.unwrap();
+    assert!(bus.slaves[0].device.objects.contains_key(&0x2000));
+    assert!(loaded.files[0].ends_with("eds/linak_techline.yaml"));
+}
+
+#[test]
+fn node_id_from_a_dcf() {
+    let loaded = read(&format!("{MASTER}a:\n  dcf: ../diff/06_dcf/old.dcf\n"));
+    assert!(
+        !loaded.diagnostics.has_errors(),
+        "{}",
+        loaded.diagnostics.render()
+    );
+    let a = &loaded.bus.unwrap().slaves[0];
+    assert!(a.node_id.is_none());
+    // The DCF's [DeviceComissioning] NodeID.
+    assert_eq!(a.effective_node_id(), Some(5));
 }
 
 #[test]
@@ -285,11 +321,12 @@ fn unknown_keys_in_items_are_warnings() {
 #[test]
 fn duplicates() {
     let e = one_error(&format!(
-        "{MASTER}defaults:\n  dcf: base_ok.eds\nnodes:\n  a: {{node_id: 2}}\na:\n  dcf: base_ok.eds\n"
+        "{MASTER}defaults:\n  dcf: base_ok.eds\nnodes:\n  a: {{node_id: 2}}\n  .b: {{}}\n  \
+         a: {{node_id: 3}}\n"
     ));
     assert_eq!(
         e,
-        "6 net::duplicate-node a: a slave of this name is given already (line 7); this node is \
+        "8 net::duplicate-node a: a slave of this name is given already (line 6); this one is \
          not read"
     );
     let e = one_error(&format!(
@@ -396,6 +433,17 @@ fn hostile_inputs_do_not_panic() {
     for n in 0..100 {
         wide.push_str(&format!("  n{n}: {{}}\n"));
     }
+    // Quadratic work on many keys would show here.
+    let mut keys = String::from("master: {node_id: 1}\na:\n  dcf: base_ok.eds\n");
+    let mut sections = String::from("master: {node_id: 1}\n");
+    for n in 0..50_000 {
+        keys.push_str(&format!("  k{n}: 1\n"));
+        sections.push_str(&format!("s{n}: 1\n"));
+    }
+    let started = std::time::Instant::now();
+    assert_eq!(read(&keys).bus.unwrap().extra_keys.len(), 50_000);
+    assert!(read(&sections).diagnostics.has_errors());
+    assert!(started.elapsed().as_secs() < 20, "{:?}", started.elapsed());
     for (text, code) in [
         (deep.as_str(), "net::syntax"),
         (bomb, "net::syntax"),

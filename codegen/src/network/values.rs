@@ -2,6 +2,8 @@
 //! `int()`, `float()`, `bool()` and `str()` on what PyYAML gives), each
 //! problem reported with file, line and key path.
 
+use std::collections::HashMap;
+
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
 use crate::table::At;
 
@@ -92,6 +94,7 @@ impl Ctx<'_> {
             }
         };
         let mut out: Vec<Entry<'n>> = Vec::with_capacity(pairs.len());
+        let mut seen: HashMap<String, usize> = HashMap::with_capacity(pairs.len());
         for (key_node, value) in pairs {
             let Some(key) = key_node.key_text() else {
                 self.error(
@@ -105,25 +108,32 @@ impl Ctx<'_> {
                 );
                 continue;
             };
-            let full = join(path, &key);
-            if let Some(pos) = out.iter().position(|e| e.key == key) {
-                let first = out.remove(pos);
-                self.warn(
-                    "net::duplicate-key",
-                    key_node.at,
-                    &full,
-                    format!(
-                        "key given again (first at line {}); this later value wins, as in dcfgen",
-                        first.key_node.at.line
-                    ),
-                );
-            }
-            out.push(Entry {
+            let entry = Entry {
+                path: join(path, &key),
                 key,
                 key_node,
                 value,
-                path: full,
-            });
+            };
+            match seen.get(&entry.key) {
+                // As in a Python dict: the first place, the later value.
+                Some(&pos) => {
+                    self.warn(
+                        "net::duplicate-key",
+                        key_node.at,
+                        &entry.path,
+                        format!(
+                            "key given again (first at line {}); this later value wins, as in \
+                             dcfgen",
+                            out[pos].key_node.at.line
+                        ),
+                    );
+                    out[pos] = entry;
+                }
+                None => {
+                    seen.insert(entry.key.clone(), out.len());
+                    out.push(entry);
+                }
+            }
         }
         Some(out)
     }
@@ -179,8 +189,8 @@ impl Ctx<'_> {
         }
     }
 
-    /// An integer in `lo..=hi`, of type `T`; `what` names the range's
-    /// meaning for the message (`u16`, `node id`).
+    /// An integer in `lo..=hi`, of type `T`; a value outside is an error
+    /// of rule `code`.
     pub fn ranged<T: TryFrom<i128>>(
         &mut self,
         node: &Node,
