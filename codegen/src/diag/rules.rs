@@ -160,6 +160,10 @@ pub const RULES: &[Rule] = &[
         "an input file above the size limit (--max-input-size)",
     ),
     rule(
+        "net::pdo-not-generated",
+        "a PDO a network configures that gets no generated struct",
+    ),
+    rule(
         "table::array-type",
         "an ARRAY whose subs do not share one type",
     ),

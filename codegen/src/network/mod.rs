@@ -4,6 +4,7 @@
 //! DCFs.
 
 pub mod config;
+pub mod configured;
 pub mod model;
 
 use std::path::{Path, PathBuf};
