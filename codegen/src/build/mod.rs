@@ -48,7 +48,7 @@ pub use builder::{Builder, Report, WARNINGS_FILE};
 pub use cargo::{cargo_lines, error_lines, in_build_script, project_dir};
 pub use error::Error;
 pub use files::write_whole;
-pub use network::{GeneratedNetwork, generate_network};
+pub use network::{GeneratedNetwork, generate_bus, generate_network};
 
 /// What generating one device produced.
 #[derive(Debug, Clone)]

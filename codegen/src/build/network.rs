@@ -37,21 +37,50 @@ pub fn generate_network(
 ) -> GeneratedNetwork {
     let loaded = crate::network::read_file(bus_file, read);
     let mut diagnostics = loaded.diagnostics;
-    let files = loaded.files;
-    let mut result = None;
-    if let Some(bus) = &loaded.bus
-        && !diagnostics.has_errors()
-    {
-        let (configured, found) = configure(bus);
-        diagnostics.extend(found);
-        if !diagnostics.has_errors() {
-            result = generate_configured(name, bus, &configured.nodes, options, &mut diagnostics);
+    let result = match &loaded.bus {
+        Some(bus) if !diagnostics.has_errors() => {
+            let (result, found) = generate_bus(name, bus, options);
+            diagnostics.extend(found);
+            result
         }
+        _ => None,
+    };
+    GeneratedNetwork {
+        result: finish(result, diagnostics, bus_file, options, read),
+        files: loaded.files,
     }
+}
+
+/// [`generate_network`] of a bus already read: the files (`None` when
+/// there is an error) and the diagnostics of configuring and generating
+/// (no levels applied).
+pub fn generate_bus(
+    name: &str,
+    bus: &Bus,
+    options: &Options,
+) -> (Option<Vec<(PathBuf, String)>>, Diagnostics) {
+    let (configured, mut diagnostics) = configure(bus);
+    if diagnostics.has_errors() {
+        return (None, diagnostics);
+    }
+    let files = generate_configured(name, bus, &configured.nodes, options, &mut diagnostics);
+    (files, diagnostics)
+}
+
+/// The result of a network: its levels applied, an error when nothing
+/// came out.
+#[allow(clippy::type_complexity)]
+fn finish(
+    files: Option<Vec<(PathBuf, String)>>,
+    mut diagnostics: Diagnostics,
+    bus_file: &Path,
+    options: &Options,
+    read: &crate::read::Options,
+) -> Result<(Vec<(PathBuf, String)>, Diagnostics), Diagnostics> {
     diagnostics.apply_levels(&read.levels, options.strict || read.strict);
     diagnostics.sort();
-    let result = match result {
-        Some(out) if !diagnostics.has_errors() => Ok((out, diagnostics)),
+    match files {
+        Some(files) if !diagnostics.has_errors() => Ok((files, diagnostics)),
         _ => {
             if !diagnostics.has_errors() {
                 diagnostics.push(error_at(
@@ -63,8 +92,7 @@ pub fn generate_network(
             }
             Err(diagnostics)
         }
-    };
-    GeneratedNetwork { result, files }
+    }
 }
 
 fn generate_configured(
@@ -188,34 +216,16 @@ fn node_input<'a>(
     module: String,
     pdos: Vec<NodePdo>,
 ) -> NodeInput<'a> {
-    let identity = &slave.device.identity;
-    let entry_default = |sub: u8| {
-        slave
-            .device
-            .objects
-            .get(&0x1018)
-            .and_then(|o| o.entries.get(&sub))
-            .and_then(|e| e.parameter_value.as_ref().or(e.default.as_ref()))
-            .filter(|l| !l.plus_node_id)
-            .and_then(|l| match l.value {
-                crate::ir::Value::Integer(v) => u32::try_from(v).ok(),
-                _ => None,
-            })
-    };
     NodeInput {
         name: &node.name,
         module,
         node_id: node.node_id,
-        vendor_id: identity.vendor_number.or_else(|| entry_default(1)).unwrap_or(0),
-        product_code: identity.product_number.or_else(|| entry_default(2)).unwrap_or(0),
-        revision_number: slave
-            .revision_number
-            .as_ref()
-            .map(|r| r.value)
-            .unwrap_or(0),
-        serial_number: slave.serial_number.as_ref().map(|s| s.value).unwrap_or(0),
+        vendor_id: node.vendor_id,
+        product_code: node.product_code,
+        revision_number: node.revision_number,
+        serial_number: node.serial_number,
         heartbeat_producer_ms: node.heartbeat_producer,
-        product_name: identity.product_name.as_deref(),
+        product_name: slave.device.identity.product_name.as_deref(),
         device_file: slave.dcf.value.clone(),
         pdos,
     }

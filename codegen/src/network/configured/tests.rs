@@ -23,6 +23,13 @@ fn node(rpdos: Vec<Pdo>, tpdos: Vec<Pdo>) -> Node {
         heartbeat_consumer: false,
         emcy_cob_id: 0xA0,
         time_cob_id: 0x100,
+        device_type: 0,
+        vendor_id: 0x4AA,
+        product_code: 0,
+        revision_number: 0,
+        serial_number: 0,
+        dcf_path: String::new(),
+        configuration_file: String::new(),
     }
 }
 
