@@ -9,7 +9,8 @@ use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
 use crate::r#gen::rust::network::{self as gen_network, Master, Network, NodeInput, NodePdo};
 use crate::r#gen::rust::{self, Options, check_runtime_path};
 use crate::ir::{Origin, PdoDirection};
-use crate::network::config::{Node, configure};
+use crate::network::config::Node;
+use crate::network::configure;
 use crate::network::configured::configured_device;
 use crate::network::model::{Bus, SlaveSection};
 
