@@ -170,8 +170,7 @@ fn generate_configured(
                     format!(
                         "{} {direction:?}{} gets no generated struct (the warning of \
                          its device file says why), so the typed network would lack it",
-                        node.name,
-                        pdo.number
+                        node.name, pdo.number
                     )
                     .replace("Rpdo", "RPDO")
                     .replace("Tpdo", "TPDO"),

@@ -164,12 +164,28 @@ pub const RULES: &[Rule] = &[
         "a PDO with cob_id: auto when no 11-bit COB-ID is left (0x680–0x6DF used up)",
     ),
     rule(
+        "net::device-file",
+        "a slave's device file that cannot be read",
+    ),
+    rule(
+        "net::duplicate-key",
+        "a key given twice in one map of a bus file (the later wins)",
+    ),
+    rule(
+        "net::duplicate-node",
+        "a slave name given twice in a bus file",
+    ),
+    rule(
         "net::heartbeat-and-guarding",
         "a node with both a heartbeat producer time and node guarding",
     ),
     rule(
         "net::identity-differs",
         "a bus file's revision or serial number that differs from the device file's",
+    ),
+    rule(
+        "net::missing-key",
+        "a key dcfgen needs (`master:`, a slave's `dcf`, an item's `index`)",
     ),
     rule(
         "net::missing-object",
@@ -183,6 +199,7 @@ pub const RULES: &[Rule] = &[
         "net::no-such-pdo",
         "an rpdo/tpdo number the device file has no PDO for",
     ),
+    rule("net::node-id", "a node id outside 1..=127 in a bus file"),
     rule(
         "net::not-writable",
         "a configuration write to an entry that is not writable",
@@ -192,9 +209,34 @@ pub const RULES: &[Rule] = &[
         "a PDO a network configures that gets no generated struct",
     ),
     rule(
+        "net::pdo-number",
+        "a PDO number outside 1..=512 in a bus file",
+    ),
+    rule(
+        "net::syntax",
+        "bus file YAML syntax, not UTF-8, over a limit, or not a map",
+    ),
+    rule(
+        "net::too-large",
+        "more than 127 slaves, or `defaults:` expanded beyond the limit",
+    ),
+    rule(
+        "net::truncated",
+        "a fraction where dcfgen needs an integer (it cuts it)",
+    ),
+    rule(
+        "net::truthy-text",
+        "text where dcfgen reads a boolean (any non-empty text is true)",
+    ),
+    rule(
+        "net::unknown-key",
+        "an unknown key in a PDO, mapping or sdo item (dcfgen ignores it)",
+    ),
+    rule(
         "net::unknown-object",
         "a write or mapping of an object or sub-object the device file lacks",
     ),
+    rule("net::unused-defaults", "`defaults:` without `nodes:`"),
     rule(
         "net::value-range",
         "a configuration value that does not fit its entry's data type",

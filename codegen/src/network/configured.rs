@@ -46,9 +46,7 @@ pub fn configured_device(device: &Device, node: &Node) -> Device {
             None => set(object, 0, 0, "0".into()),
         }
         if let Some(pdo) = pdo
-            && let Some(comm) = out
-                .objects
-                .get_mut(&direction.communication_index(number))
+            && let Some(comm) = out.objects.get_mut(&direction.communication_index(number))
         {
             write_communication(comm, direction, pdo);
         }
@@ -76,12 +74,7 @@ fn mapped(object: &Object) -> Vec<MappedObject> {
 }
 
 fn write_mapping(object: &mut Object, mapping: &[MappedObject]) {
-    set(
-        object,
-        0,
-        mapping.len() as i128,
-        mapping.len().to_string(),
-    );
+    set(object, 0, mapping.len() as i128, mapping.len().to_string());
     for (i, item) in mapping.iter().enumerate() {
         let Ok(sub) = u8::try_from(i + 1) else { break };
         if !object.entries.contains_key(&sub) {
@@ -119,12 +112,7 @@ fn write_communication(comm: &mut Object, direction: PdoDirection, pdo: &Pdo) {
         );
         set(comm, 6, pdo.sync_start.into(), pdo.sync_start.to_string());
     }
-    set(
-        comm,
-        5,
-        pdo.event_timer.into(),
-        pdo.event_timer.to_string(),
-    );
+    set(comm, 5, pdo.event_timer.into(), pdo.event_timer.to_string());
 }
 
 /// Sets the configured value of an entry the object has.

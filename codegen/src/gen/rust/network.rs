@@ -77,7 +77,9 @@ pub(crate) fn module_names(nodes: &[(&str, u8, Origin)], diags: &mut Diagnostics
         .map(|(name, id, origin)| ns.request(name, &format!("node {id}"), Some(origin)))
         .collect();
     let names = ns.resolve(diags);
-    ids.into_iter().map(|id| names.text(id).to_string()).collect()
+    ids.into_iter()
+        .map(|id| names.text(id).to_string())
+        .collect()
 }
 
 /// The formatted top file.
@@ -262,6 +264,10 @@ fn image(network: &Network, direction: PdoDirection, rt: &TokenStream) -> TokenS
                     }
                 }
             });
+            // Without inputs the match has one arm.
+            let allow = fields
+                .is_empty()
+                .then(|| quote!(#[allow(clippy::match_single_binding)]));
             let mut derive_list = derives::names(derives::PDO, float);
             derive_list.push("Default");
             let derive_idents = derive_list.iter().map(|d| naming::ident(d));
@@ -283,7 +289,7 @@ fn image(network: &Network, direction: PdoDirection, rt: &TokenStream) -> TokenS
                         if frame.is_remote() {
                             return ::core::result::Result::Ok(false);
                         }
-                        #[allow(clippy::match_single_binding)]
+                        #allow
                         match frame.id() {
                             #(#arms)*
                             _ => ::core::result::Result::Ok(false),
@@ -344,7 +350,13 @@ mod tests {
         let names = module_names(&nodes, &mut diags);
         assert_eq!(
             names,
-            ["zimmer_axis", "network_node_2", "type_", "axis_1_node_4", "axis_1_node_5"]
+            [
+                "zimmer_axis",
+                "network_node_2",
+                "type_",
+                "axis_1_node_4",
+                "axis_1_node_5"
+            ]
         );
         assert!(diags.iter().any(|d| d.code == "gen::name-collision"));
     }

@@ -356,10 +356,11 @@ fn emit_struct(
     }
     let comm = device.objects.get(&comm_index);
     let comm_default = |sub: u8| {
-        comm.and_then(|o| o.entries.get(&sub)).and_then(|e| match source {
-            Source::Defaults => e.default.as_ref(),
-            Source::Network => e.parameter_value.as_ref().or(e.default.as_ref()),
-        })
+        comm.and_then(|o| o.entries.get(&sub))
+            .and_then(|e| match source {
+                Source::Defaults => e.default.as_ref(),
+                Source::Network => e.parameter_value.as_ref().or(e.default.as_ref()),
+            })
     };
     let mut facts = Vec::new();
     if source == Source::Network

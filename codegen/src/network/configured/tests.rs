@@ -47,7 +47,9 @@ fn pdo(number: u16, cob_id: u32, mapping: &[u32]) -> Pdo {
 }
 
 fn configured_value(device: &Device, index: u16, sub: u8) -> Option<i128> {
-    let literal = device.objects[&index].entries[&sub].parameter_value.as_ref()?;
+    let literal = device.objects[&index].entries[&sub]
+        .parameter_value
+        .as_ref()?;
     match literal.value {
         Value::Integer(v) => Some(v),
         _ => None,
