@@ -175,3 +175,43 @@ fn the_builder_writes_the_network_and_reruns_on_every_input() {
         .expect_err("not an identifier");
     assert!(err.to_string().contains("network name"), "{err}");
 }
+
+/// A node's object dictionary is the device's as `Builder::device` makes it
+/// (identity, `od`, `errors`): only `pdo` differs.
+#[test]
+fn a_node_is_its_device_but_for_the_pdos() {
+    let generated = generate_network(
+        "machine",
+        Path::new(MACHINE),
+        &Options::default(),
+        &Default::default(),
+    );
+    let (files, _) = generated.result.expect("the machine generates");
+    for (node, table) in [
+        ("axis", "zimmer_acs.yaml"),
+        ("actuator", "linak_techline.yaml"),
+        ("conveyor", "interroll_ec5000bi.yaml"),
+    ] {
+        let path = format!("../eds/machine/../{table}");
+        let device = eds2rust::build::generate(Path::new(&path), &[], &Options::default())
+            .unwrap_or_else(|d| panic!("{}", d.render()));
+        let (_, code) = files
+            .iter()
+            .find(|(p, _)| p.ends_with(format!("{node}.rs")))
+            .expect("the node's file");
+        let before = |text: &str| -> usize {
+            text.find("\n/// The PDOs the network configures")
+                .or_else(|| text.find("\n/// Default PDOs"))
+                .unwrap_or(text.len())
+        };
+        let (node_od, device_od) = (&code[..before(code)], &device[..before(&device)]);
+        assert!(
+            node_od == device_od,
+            "{node}: the object dictionary differs"
+        );
+        assert!(
+            code.contains("\n/// The PDOs the network configures"),
+            "{node}"
+        );
+    }
+}
