@@ -256,14 +256,21 @@ fn image(network: &Network, direction: PdoDirection, rt: &TokenStream) -> TokenS
             let defs = fields
                 .iter()
                 .map(|(f, ty, doc, _)| quote!(#[doc = #doc] pub #f: ::core::option::Option<#ty>));
-            let arms = fields.iter().map(|(f, ty, _, id)| {
-                quote! {
-                    #id => {
-                        self.#f = ::core::option::Option::Some(#ty::decode(frame.data())?);
-                        ::core::result::Result::Ok(true)
-                    }
-                }
-            });
+            // Two inputs on one identifier (a collision `net check`
+            // reports): the first takes the frame.
+            let mut ids = std::collections::BTreeSet::new();
+            let arms =
+                fields
+                    .iter()
+                    .filter(|f| ids.insert(f.3.to_string()))
+                    .map(|(f, ty, _, id)| {
+                        quote! {
+                            #id => {
+                                self.#f = ::core::option::Option::Some(#ty::decode(frame.data())?);
+                                ::core::result::Result::Ok(true)
+                            }
+                        }
+                    });
             // Without inputs the match has one arm.
             let allow = fields
                 .is_empty()
@@ -359,5 +366,74 @@ mod tests {
             ]
         );
         assert!(diags.iter().any(|d| d.code == "gen::name-collision"));
+    }
+
+    fn input(name: &str, pdos: Vec<NodePdo>) -> NodeInput<'_> {
+        NodeInput {
+            name,
+            module: name.into(),
+            node_id: 2,
+            vendor_id: 0,
+            product_code: 0,
+            revision_number: 0,
+            serial_number: 0,
+            heartbeat_producer_ms: 0,
+            product_name: None,
+            device_file: "d.eds".into(),
+            pdos,
+        }
+    }
+
+    fn tpdo(number: u16, cob_id: u32) -> NodePdo {
+        NodePdo {
+            pdo: Emitted {
+                direction: PdoDirection::Tpdo,
+                number,
+                ident: format!("Tpdo{number}"),
+                len: 2,
+                float: false,
+            },
+            cob_id,
+            transmission: 1,
+        }
+    }
+
+    fn network(nodes: Vec<NodeInput<'_>>) -> String {
+        let network = Network {
+            source: "bus.yml",
+            dir: "net",
+            master: Master {
+                node_id: 1,
+                bit_rate_kbit: 500,
+                sync_period_us: 0,
+                sync_window_us: 0,
+                heartbeat_producer_ms: 0,
+            },
+            nodes,
+        };
+        generate(&network, &quote!(::eds2rust_runtime)).expect("valid Rust")
+    }
+
+    #[test]
+    fn an_empty_network_is_valid_rust() {
+        let code = network(Vec::new());
+        assert!(code.contains("pub const NODES: [Node; 0] = [];"), "{code}");
+        assert!(
+            code.contains("pub fn frames(&self) -> [rt::Frame; 0]"),
+            "{code}"
+        );
+        assert!(code.contains("clippy::match_single_binding"), "{code}");
+    }
+
+    #[test]
+    fn two_inputs_on_one_identifier_give_one_arm() {
+        let code = network(vec![input("a", vec![tpdo(1, 0x182), tpdo(2, 0x182)])]);
+        assert_eq!(
+            code.matches("rt::CanId::Standard(0x182) =>").count(),
+            1,
+            "{code}"
+        );
+        assert!(code.contains("pub a_tpdo2:"), "{code}");
+        assert!(!code.contains("clippy::match_single_binding"), "{code}");
     }
 }
