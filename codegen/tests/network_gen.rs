@@ -121,6 +121,11 @@ fn a_mapping_of_a_missing_object_names_the_bus_file_line_and_object() {
     );
     assert_eq!(error.location.line, Some(10), "{}", diagnostics.render());
     assert!(error.message.contains("0x6099"), "{}", diagnostics.render());
+    let rendered = diagnostics
+        .render()
+        .replace(&dir.display().to_string(), "<dir>")
+        .replace(env!("CARGO_MANIFEST_DIR"), "<codegen>");
+    insta::assert_snapshot!("missing_object", rendered);
     // Through the builder, the same error and nothing written.
     let out = dir.join("out");
     let err = Builder::new()
