@@ -87,7 +87,7 @@ fn without_spots(slave: &SlaveSection) -> String {
     for item in &mut s.sdo {
         item.spot = blank.clone();
     }
-    s.device = Box::default();
+    *s.device = Default::default();
     format!("{s:#?}")
 }
 

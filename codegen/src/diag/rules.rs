@@ -164,8 +164,16 @@ pub const RULES: &[Rule] = &[
         "a PDO with cob_id: auto when no 11-bit COB-ID is left (0x680–0x6DF used up)",
     ),
     rule(
+        "net::bad-value",
+        "a bus file value of the wrong type or outside its key's range",
+    ),
+    rule(
         "net::device-file",
         "a slave's device file that cannot be read",
+    ),
+    rule(
+        "net::dropped-section",
+        "a slave section beside `nodes:`, which ros2_canopen's expansion drops",
     ),
     rule(
         "net::duplicate-key",

@@ -1,13 +1,16 @@
 //! The top level of a bus file: `options:`, `master:`, the flat slave
 //! sections, and ros2_canopen's `defaults:` + `nodes:`, expanded as
-//! ros2_canopen expands them before it calls dcfgen: each entry of
-//! `nodes:` becomes a slave with the keys of `defaults:` put over its own
-//! (a dict update: the defaults win, a nested map such as `tpdo` is
-//! replaced whole), and the slaves are then ordered by name (ros2_canopen
-//! writes the expanded file with its keys sorted, and dcfgen numbers the
-//! master's PDOs in that order). A file without `nodes:` is dcfgen's own
-//! input: its slaves stay in file order. Keys starting with `.` are
+//! ros2_canopen expands them before it calls dcfgen (its `cogen` step):
+//! each entry of `nodes:` becomes a slave with the keys of `defaults:` put
+//! over its own (the defaults win; a nested map such as `tpdo` is replaced
+//! whole), the expanded file keeps only `options:`, `master:` and the nodes
+//! (a flat slave section beside `nodes:` is dropped, with a warning), and
+//! its keys are sorted, so the slaves are ordered by name (dcfgen numbers
+//! the master's PDOs in that order). A file without `nodes:` is dcfgen's
+//! own input: its slaves stay in file order. Keys starting with `.` are
 //! ignored, as dcfgen ignores them.
+
+use std::collections::HashMap;
 
 use super::values::{Ctx, Entry, join};
 use super::yaml::{Node, Value};
@@ -38,12 +41,13 @@ pub(crate) struct SlaveSource<'n> {
     pub entries: Vec<Entry<'n>>,
 }
 
-/// Splits the top level into its sections and expands `nodes:`.
-pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Layout<'n> {
+/// Splits the top level into its sections and expands `nodes:`; `None`
+/// (with an error) when the top level is not a map.
+pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Option<Layout<'n>> {
     let mut layout = Layout::default();
     let pairs = match &root.value {
         Value::Map(pairs) => pairs,
-        Value::Null => return layout,
+        Value::Null => return Some(layout),
         other => {
             ctx.error(
                 "net::syntax",
@@ -54,12 +58,12 @@ pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Layout<'n> {
                     other.kind()
                 ),
             );
-            return layout;
+            return None;
         }
     };
     let mut defaults: Option<Entry<'n>> = None;
     let mut nodes: Option<Entry<'n>> = None;
-    let mut flat: Vec<Entry<'n>> = Vec::new();
+    let mut flat = Slaves::default();
     for (key_node, value) in pairs {
         let Value::Str(key) = &key_node.value else {
             ctx.error(
@@ -104,12 +108,34 @@ pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Layout<'n> {
             );
         }
     }
-    let sorted = nodes.is_some();
-    for entry in flat {
-        if let Some(slave) = flat_slave(ctx, entry) {
-            layout.slaves.push(slave);
+    match &nodes {
+        Some(nodes) => {
+            for entry in flat.list {
+                ctx.warn(
+                    "net::dropped-section",
+                    entry.key_node.at,
+                    &entry.path,
+                    format!(
+                        "a file with `nodes:` (line {}) is expanded by ros2_canopen, which keeps \
+                         only options:, master: and the nodes: this section is not on the bus",
+                        nodes.key_node.at.line
+                    ),
+                );
+                ctx.note(format!(
+                    "move it into `nodes:` to put {} on the bus",
+                    entry.key
+                ));
+            }
+        }
+        None => {
+            for entry in flat.list {
+                if let Some(slave) = flat_slave(ctx, entry) {
+                    layout.slaves.push(slave);
+                }
+            }
         }
     }
+    let sorted = nodes.is_some();
     match (nodes, defaults) {
         (Some(nodes), defaults) => expand(ctx, &mut layout.slaves, &nodes, defaults.as_ref()),
         (None, Some(defaults)) => ctx.warn(
@@ -137,14 +163,14 @@ pub(crate) fn layout<'n>(ctx: &mut Ctx, root: &'n Node) -> Layout<'n> {
         );
         layout.slaves.truncate(MAX_SLAVES);
     }
-    layout
+    Some(layout)
 }
 
 /// Adds a slave section, unless its name is taken (an error: dcfgen would
 /// silently read only the later one).
-fn add_slave<'n>(ctx: &mut Ctx, slaves: &mut Vec<Entry<'n>>, entry: Entry<'n>) {
-    if let Some(first) = slaves.iter().find(|s| s.key == entry.key) {
-        let line = first.key_node.at.line;
+fn add_slave<'n>(ctx: &mut Ctx, slaves: &mut Slaves<'n>, entry: Entry<'n>) {
+    if let Some(&pos) = slaves.seen.get(&entry.key) {
+        let line = slaves.list[pos].key_node.at.line;
         ctx.error(
             "net::duplicate-node",
             entry.key_node.at,
@@ -153,7 +179,15 @@ fn add_slave<'n>(ctx: &mut Ctx, slaves: &mut Vec<Entry<'n>>, entry: Entry<'n>) {
         );
         return;
     }
-    slaves.push(entry);
+    slaves.seen.insert(entry.key.clone(), slaves.list.len());
+    slaves.list.push(entry);
+}
+
+/// Slave sections by name, in file order.
+#[derive(Default)]
+struct Slaves<'n> {
+    list: Vec<Entry<'n>>,
+    seen: HashMap<String, usize>,
 }
 
 fn flat_slave<'n>(ctx: &mut Ctx, entry: Entry<'n>) -> Option<SlaveSource<'n>> {
@@ -197,29 +231,25 @@ fn expand<'n>(
         return;
     }
     for node in node_entries {
-        if let Some(first) = slaves.iter().find(|s| s.name == node.key) {
-            let line = first.key_node.at.line;
-            ctx.error(
-                "net::duplicate-node",
-                node.key_node.at,
-                &node.key,
-                format!(
-                    "a slave of this name is given already (line {line}); this node is not read"
-                ),
-            );
-            continue;
-        }
         let Some(mut entries) = ctx.entries(node.value, &node.key) else {
             continue;
         };
+        let mut own: HashMap<String, usize> = entries
+            .iter()
+            .enumerate()
+            .map(|(n, e)| (e.key.clone(), n))
+            .collect();
         for default in &default_entries {
             let merged = Entry {
                 path: join(&node.key, &default.key),
                 ..default.clone()
             };
-            match entries.iter_mut().find(|e| e.key == default.key) {
-                Some(own) => *own = merged,
-                None => entries.push(merged),
+            match own.get(&default.key) {
+                Some(&pos) => entries[pos] = merged,
+                None => {
+                    own.insert(default.key.clone(), entries.len());
+                    entries.push(merged);
+                }
             }
         }
         slaves.push(SlaveSource {
@@ -246,7 +276,7 @@ fn node_list<'n>(ctx: &mut Ctx, nodes: &Entry<'n>) -> Option<Vec<Entry<'n>>> {
             return None;
         }
     };
-    let mut out: Vec<Entry<'n>> = Vec::new();
+    let mut out = Slaves::default();
     for (key_node, value) in pairs {
         let Value::Str(key) = &key_node.value else {
             ctx.error(
@@ -260,6 +290,9 @@ fn node_list<'n>(ctx: &mut Ctx, nodes: &Entry<'n>) -> Option<Vec<Entry<'n>>> {
             );
             continue;
         };
+        if key.starts_with('.') {
+            continue;
+        }
         add_slave(
             ctx,
             &mut out,
@@ -271,5 +304,5 @@ fn node_list<'n>(ctx: &mut Ctx, nodes: &Entry<'n>) -> Option<Vec<Entry<'n>>> {
             },
         );
     }
-    Some(out)
+    Some(out.list)
 }

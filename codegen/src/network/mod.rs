@@ -16,6 +16,9 @@ mod values;
 mod view;
 mod yaml;
 
+#[cfg(test)]
+mod tests;
+
 use std::path::{Path, PathBuf};
 
 use crate::diag::Diagnostics;
@@ -39,28 +42,49 @@ pub struct BusLoaded {
 /// line and key. Levels and strictness of `options` apply to the bus
 /// file's diagnostics and to its device files'.
 pub fn read_file(path: &Path, options: &Options) -> BusLoaded {
-    let name = path.display().to_string();
-    let mut diagnostics = Diagnostics::new();
-    let mut files = vec![path.to_path_buf()];
-    let bus = match crate::read::Loaded::read_bounded(path, options) {
+    match crate::read::Loaded::read_bounded(path, options) {
         Ok(bytes) => {
             let dir = path.parent().unwrap_or(Path::new(""));
-            let mut devices = read::Devices::new(dir, options);
-            let bus = read_text(&name, &bytes, path, &mut diagnostics, &mut devices);
-            diagnostics.apply_levels(&options.levels, options.strict);
-            diagnostics.extend(devices.diagnostics);
-            for file in devices.files {
-                if !files.contains(&file) {
-                    files.push(file);
-                }
-            }
-            bus
+            read_in(path, &bytes, dir, options, true)
         }
         Err(refused) => {
-            diagnostics.extend(refused.diagnostics);
-            None
+            let mut diagnostics = refused.diagnostics;
+            diagnostics.sort();
+            BusLoaded {
+                bus: None,
+                diagnostics,
+                files: vec![path.to_path_buf()],
+            }
         }
-    };
+    }
+}
+
+/// Reads a bus file's content; `file` names it in diagnostics and in
+/// [`model::Bus::file`], device files are resolved in `dir`. As
+/// [`read_file`] otherwise ([`BusLoaded::files`] lists the device files
+/// read).
+pub fn read_bytes(file: &str, bytes: &[u8], dir: &Path, options: &Options) -> BusLoaded {
+    read_in(Path::new(file), bytes, dir, options, false)
+}
+
+/// `from_disk`: the bus file itself was read from `path` (and is listed
+/// first in the files).
+fn read_in(path: &Path, bytes: &[u8], dir: &Path, options: &Options, from_disk: bool) -> BusLoaded {
+    let name = path.display().to_string();
+    let mut diagnostics = Diagnostics::new();
+    let mut files = Vec::new();
+    if from_disk {
+        files.push(path.to_path_buf());
+    }
+    let mut devices = read::Devices::new(dir, options);
+    let bus = read_text(&name, bytes, path, &mut diagnostics, &mut devices);
+    diagnostics.apply_levels(&options.levels, options.strict);
+    diagnostics.extend(devices.diagnostics);
+    for file in devices.files {
+        if !files.contains(&file) {
+            files.push(file);
+        }
+    }
     diagnostics.sort();
     BusLoaded {
         bus,
@@ -109,7 +133,7 @@ fn read_text(
         diags: diagnostics,
     };
     match yaml::parse(text) {
-        Ok(root) => Some(read::bus(&mut ctx, &root, path, devices)),
+        Ok(root) => read::bus(&mut ctx, &root, path, devices),
         Err(err) => {
             let at = err.location().map_or(crate::table::At::line(0), |l| {
                 crate::table::At::from_location(&l)

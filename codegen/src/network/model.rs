@@ -45,9 +45,10 @@ pub struct Bus {
     /// `master:`.
     pub master: MasterSection,
     /// The slaves in dcfgen's order: file order, or, in a file with
-    /// `nodes:` (which only ros2_canopen reads: it expands the nodes and
-    /// writes the file with its keys sorted before dcfgen reads it), every
-    /// slave ordered by name. That order numbers the master's PDOs.
+    /// `nodes:` (which only ros2_canopen reads: it expands the nodes, drops
+    /// other slave sections and writes the file with its keys sorted before
+    /// dcfgen reads it), the nodes ordered by name. That order numbers the
+    /// master's PDOs.
     pub slaves: Vec<SlaveSection>,
     /// Keys dcfgen does not use (ros2_canopen's `driver`, `package`,
     /// `period`, ...), kept in file order. Listed at info level, never an

@@ -24,8 +24,8 @@ pub(crate) struct Devices<'o> {
     /// The bus file's directory: device paths are relative to it.
     pub dir: &'o Path,
     pub options: &'o Options,
-    /// Each device file once: its device (`None`: it could not be read).
-    cache: BTreeMap<PathBuf, Option<Device>>,
+    /// Each device file once: its device, or why it gave none.
+    cache: BTreeMap<PathBuf, Result<Device, String>>,
     /// The device files' own diagnostics.
     pub diagnostics: Diagnostics,
     /// Every file read, in order, each once.
@@ -43,8 +43,9 @@ impl<'o> Devices<'o> {
         }
     }
 
-    /// The device of `path`, read on first use. `Err` is the first error
-    /// of a file that gave no device.
+    /// The device of `path`, read on first use (its diagnostics kept).
+    /// `Err` is why a file that gave no device gave none: its first error,
+    /// which then stands for its diagnostics.
     fn get(&mut self, path: &Path) -> Result<Device, String> {
         if !self.cache.contains_key(path) {
             let loaded = crate::input::read_device(path, self.options);
@@ -53,30 +54,37 @@ impl<'o> Devices<'o> {
                     self.files.push(file.clone());
                 }
             }
-            let device = loaded.device;
-            if device.is_none() {
-                let first = loaded
-                    .diagnostics
-                    .iter()
-                    .find(|d| d.severity == crate::diag::Severity::Error)
-                    .map(|d| d.message.clone());
-                self.diagnostics.extend(loaded.diagnostics);
-                self.cache.insert(path.to_path_buf(), None);
-                return Err(first.unwrap_or_else(|| "it gives no device".into()));
+            match loaded.device {
+                Some(device) => {
+                    self.diagnostics.extend(loaded.diagnostics);
+                    self.cache.insert(path.to_path_buf(), Ok(device));
+                }
+                None => {
+                    let why = loaded
+                        .diagnostics
+                        .iter()
+                        .find(|d| d.severity == crate::diag::Severity::Error)
+                        .map_or("it gives no device".into(), |d| {
+                            let m = d.message.as_str();
+                            m.strip_prefix("cannot read the file: ")
+                                .unwrap_or(m)
+                                .to_string()
+                        });
+                    self.cache.insert(path.to_path_buf(), Err(why));
+                }
             }
-            self.diagnostics.extend(loaded.diagnostics);
-            self.cache.insert(path.to_path_buf(), device);
         }
         match self.cache.get(path) {
-            Some(Some(device)) => Ok(device.clone()),
-            _ => Err("it could not be read (see above)".into()),
+            Some(Ok(device)) => Ok(device.clone()),
+            Some(Err(why)) => Err(why.clone()),
+            None => Err("it gives no device".into()),
         }
     }
 }
 
-/// Reads the whole tree.
-pub(crate) fn bus(ctx: &mut Ctx, root: &Node, file: &Path, devices: &mut Devices) -> Bus {
-    let layout = expand::layout(ctx, root);
+/// Reads the whole tree; `None` when its top level is not a map.
+pub(crate) fn bus(ctx: &mut Ctx, root: &Node, file: &Path, devices: &mut Devices) -> Option<Bus> {
+    let layout = expand::layout(ctx, root)?;
     let mut extra_keys = Vec::new();
     let options = match &layout.options {
         Some(e) => bus_options(ctx, e, &mut extra_keys),
@@ -104,13 +112,13 @@ pub(crate) fn bus(ctx: &mut Ctx, root: &Node, file: &Path, devices: &mut Devices
         .iter()
         .filter_map(|s| slave(ctx, s, devices, &mut extra_keys))
         .collect();
-    Bus {
+    Some(Bus {
         file: file.to_path_buf(),
         options,
         master,
         slaves,
         extra_keys,
-    }
+    })
 }
 
 fn extra(section: &str, e: &Entry) -> ExtraKey {

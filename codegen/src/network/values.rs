@@ -2,6 +2,8 @@
 //! `int()`, `float()`, `bool()` and `str()` on what PyYAML gives), each
 //! problem reported with file, line and key path.
 
+use std::collections::HashMap;
+
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
 use crate::table::At;
 
@@ -92,6 +94,7 @@ impl Ctx<'_> {
             }
         };
         let mut out: Vec<Entry<'n>> = Vec::with_capacity(pairs.len());
+        let mut seen: HashMap<String, usize> = HashMap::with_capacity(pairs.len());
         for (key_node, value) in pairs {
             let Some(key) = key_node.key_text() else {
                 self.error(
@@ -105,34 +108,43 @@ impl Ctx<'_> {
                 );
                 continue;
             };
-            let full = join(path, &key);
-            if let Some(pos) = out.iter().position(|e| e.key == key) {
-                let first = out.remove(pos);
-                self.warn(
-                    "net::duplicate-key",
-                    key_node.at,
-                    &full,
-                    format!(
-                        "key given again (first at line {}); this later value wins, as in dcfgen",
-                        first.key_node.at.line
-                    ),
-                );
-            }
-            out.push(Entry {
+            let entry = Entry {
+                path: join(path, &key),
                 key,
                 key_node,
                 value,
-                path: full,
-            });
+            };
+            match seen.get(&entry.key) {
+                // As in a Python dict: the first place, the later value.
+                Some(&pos) => {
+                    self.warn(
+                        "net::duplicate-key",
+                        key_node.at,
+                        &entry.path,
+                        format!(
+                            "key given again (first at line {}); this later value wins, as in \
+                             dcfgen",
+                            out[pos].key_node.at.line
+                        ),
+                    );
+                    out[pos] = entry;
+                }
+                None => {
+                    seen.insert(entry.key.clone(), out.len());
+                    out.push(entry);
+                }
+            }
         }
         Some(out)
     }
 
     /// An integer as Python's `int()` reads it: a YAML integer, a decimal
-    /// number in quotes, a decimal fraction (cut, with a warning).
+    /// number in quotes, a boolean (1 or 0), a decimal fraction (cut, with
+    /// a warning).
     pub fn integer(&mut self, node: &Node, key: &str) -> Option<i128> {
         match &node.value {
             Value::Int(i) => Some(*i),
+            Value::Bool(b) => Some(i128::from(*b)),
             Value::Float(f) if f.is_finite() && f.abs() < 1e30 => {
                 let cut = f.trunc();
                 if cut != *f {
@@ -177,8 +189,8 @@ impl Ctx<'_> {
         }
     }
 
-    /// An integer in `lo..=hi`, of type `T`; `what` names the range's
-    /// meaning for the message (`u16`, `node id`).
+    /// An integer in `lo..=hi`, of type `T`; a value outside is an error
+    /// of rule `code`.
     pub fn ranged<T: TryFrom<i128>>(
         &mut self,
         node: &Node,
@@ -253,10 +265,7 @@ impl Ctx<'_> {
     /// A flag dcfgen reads with `int()` (the master's `start` keys):
     /// `true`/`false` or an integer (0 is false).
     pub fn int_flag(&mut self, node: &Node, key: &str) -> Option<bool> {
-        match &node.value {
-            Value::Bool(b) => Some(*b),
-            _ => self.integer(node, key).map(|i| i != 0),
-        }
+        self.integer(node, key).map(|i| i != 0)
     }
 
     /// A decimal number as Python's `float()` reads it, finite and not

@@ -151,6 +151,8 @@ fn write_brief(node: &Node, out: &mut String, max: usize) {
 pub(crate) fn parse(text: &str) -> Result<Node, serde_saphyr::Error> {
     let mut options = serde_saphyr::options! { legacy_octal_numbers: true };
     options.duplicate_keys = serde_saphyr::options::DuplicateKeyPolicy::PassThrough;
+    // `.inf` and `1e400` are values (that no key takes), not syntax.
+    options.non_finite_float_policy = serde_saphyr::NonFiniteFloatPolicy::PassThrough;
     serde_saphyr::from_str_with_options::<Node>(text, options)
 }
 
