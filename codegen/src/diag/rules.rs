@@ -213,6 +213,10 @@ pub const RULES: &[Rule] = &[
         "a configuration write to an entry that is not writable",
     ),
     rule(
+        "net::pdo-not-generated",
+        "a PDO a network configures that gets no generated struct",
+    ),
+    rule(
         "net::pdo-number",
         "a PDO number outside 1..=512 in a bus file",
     ),

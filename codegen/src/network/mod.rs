@@ -5,8 +5,9 @@
 
 pub mod config;
 mod configure;
-mod expand;
 pub use configure::configure;
+pub mod configured;
+mod expand;
 pub mod model;
 mod pdo;
 mod pdo_config;
