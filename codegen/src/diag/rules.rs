@@ -239,6 +239,10 @@ pub const RULES: &[Rule] = &[
         "a bus file's PDO mapping of an object that is not PDO-mappable",
     ),
     rule(
+        "net::pdo-not-generated",
+        "a PDO a network configures that gets no generated struct",
+    ),
+    rule(
         "net::pdo-number",
         "a PDO number outside 1..=512 in a bus file",
     ),

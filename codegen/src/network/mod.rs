@@ -7,6 +7,7 @@ pub mod check;
 pub mod config;
 mod configure;
 pub use configure::configure;
+pub mod configured;
 mod expand;
 pub mod model;
 mod pdo;
