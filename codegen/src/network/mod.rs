@@ -3,8 +3,13 @@
 //! ([`config`]), checked as a whole, and written as master.dcf and concise
 //! DCFs.
 
+pub mod api;
 pub mod config;
+pub mod diff;
 pub mod model;
+pub mod sniff;
+
+pub use sniff::is_bus_file;
 
 use std::path::{Path, PathBuf};
 
