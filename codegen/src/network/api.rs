@@ -62,7 +62,7 @@ pub fn api_listing(
 }
 
 /// Reads a bus file ([`super::read_file`]), configures it
-/// ([`super::config::configure`]) and lists it; `read`'s levels and
+/// ([`super::configure`]) and lists it; `read`'s levels and
 /// `strict` apply to every diagnostic.
 pub fn api_listing_file(
     path: &Path,
@@ -73,7 +73,7 @@ pub fn api_listing_file(
     let Some(bus) = loaded.bus.filter(|_| !diagnostics.has_errors()) else {
         return Err(diagnostics);
     };
-    let (configured, configure_diagnostics) = super::config::configure(&bus);
+    let (configured, configure_diagnostics) = super::configure(&bus);
     diagnostics.extend(configure_diagnostics);
     let options = rust::Options {
         strict: read.strict,

@@ -4,10 +4,9 @@
 //! the effective heartbeat and guarding times. One implementation, used by
 //! `net dcf`, `net check`, the generated network and the network diff.
 
-use crate::diag::Diagnostics;
 use crate::ir::pdo::MappedObject;
 
-use super::model::{Bus, Spot};
+use super::model::Spot;
 
 /// The configured network.
 #[derive(Debug, Clone)]
@@ -47,6 +46,20 @@ pub struct Node {
     /// The COB-IDs of the node's EMCY (0x1014, bit 31 kept) and TIME (0x1012).
     pub emcy_cob_id: u32,
     pub time_cob_id: u32,
+    /// Identity as the master checks it (0x1000, 0x1018 sub 1–4, from the
+    /// device file's `[DeviceInfo]`/0x1018/`[DeviceComissioning]` and the
+    /// bus file's `revision_number`/`serial_number`); 0 means not checked.
+    pub device_type: u32,
+    pub vendor_id: u32,
+    pub product_code: u32,
+    pub revision_number: u32,
+    pub serial_number: u32,
+    /// Where the master finds this node's files at run time (`dcf_path`).
+    pub dcf_path: String,
+    /// The node's concise DCF as the master names it in 0x1F22
+    /// (`<dcf_path>/<name>.bin`, or the bus file's `configuration_file`);
+    /// empty when there is none.
+    pub configuration_file: String,
 }
 
 /// One PDO as configured.
@@ -74,11 +87,4 @@ pub struct ConciseEntry {
     pub data: Vec<u8>,
     /// The bus file's key that causes it, where there is one.
     pub spot: Option<Spot>,
-}
-
-/// Applies the bus file to every device as dcfgen does; what dcfgen warns
-/// about or refuses becomes a diagnostic naming the bus file, line and key.
-pub fn configure(bus: &Bus) -> (Configured, Diagnostics) {
-    let _ = bus;
-    todo!("net-dcf helper")
 }

@@ -5,9 +5,13 @@
 
 pub mod api;
 pub mod config;
+mod configure;
+pub use configure::configure;
 pub mod diff;
 pub mod model;
+mod pdo_config;
 pub mod sniff;
+mod view;
 
 pub use sniff::is_bus_file;
 

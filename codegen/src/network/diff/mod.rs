@@ -1,5 +1,5 @@
 //! A network change reviewed: two bus files compared as the networks dcfgen
-//! configures from them ([`super::config::configure`]). Nodes are matched
+//! configures from them ([`super::configure`]). Nodes are matched
 //! by their YAML key; each pair's device files are compared by the device
 //! diff ([`crate::diff`], unchanged), and the wiring by the rules here: a
 //! node added or removed, its node id or device identity changed, a PDO
@@ -18,8 +18,11 @@
 //!
 //! This module uses [`crate::diff`]; `crate::diff` does not use it.
 
+mod boot;
+mod nodes;
+mod out;
 pub mod render;
-mod wiring;
+mod sections;
 
 use crate::diff::{Kind, Severity, Val};
 
@@ -188,10 +191,10 @@ pub struct NetChange {
 /// apply to each node's device diff (`ignore_semantics`).
 pub fn diff(old: Network, new: Network, options: &crate::diff::Options) -> Vec<NetChange> {
     let mut out = Vec::new();
-    wiring::bus(&mut out, old.bus, new.bus);
+    sections::bus(&mut out, old.bus, new.bus);
     for node in &new.configured.nodes {
         match old.configured.nodes.iter().find(|n| n.name == node.name) {
-            None => wiring::node_added(&mut out, new.bus, node),
+            None => nodes::node_added(&mut out, new.bus, node),
             Some(old_node) => {
                 // `configure` keeps `slave` in range; a hand-built network
                 // that does not is skipped, never a panic.
@@ -201,20 +204,22 @@ pub fn diff(old: Network, new: Network, options: &crate::diff::Options) -> Vec<N
                 ) else {
                     continue;
                 };
-                wiring::node(
-                    &mut out,
-                    wiring::Pair {
-                        old: (old.bus, old_node, old_slave),
-                        new: (new.bus, node, new_slave),
-                    },
-                );
+                let (old_side, new_side) =
+                    ((old.bus, old_node, old_slave), (new.bus, node, new_slave));
+                let mut o = out::Out {
+                    out: &mut out,
+                    node: &node.name,
+                };
+                nodes::node(&mut o, old_side, new_side);
+                boot::sdo_writes(&mut o, old_slave, new_slave);
+                boot::settings(&mut o, old_side, new_side);
                 device(&mut out, &node.name, old_slave, new_slave, options);
             }
         }
     }
     for node in &old.configured.nodes {
         if !new.configured.nodes.iter().any(|n| n.name == node.name) {
-            wiring::node_removed(&mut out, old.bus, node);
+            nodes::node_removed(&mut out, old.bus, node);
         }
     }
     out
