@@ -80,8 +80,9 @@ pub(super) fn node(o: &mut Out, old: Side, new: Side) {
         );
     }
     identity_changes(o, (on, os), (nn, ns));
-    pdos(o, "RPDO", 0x1400, &on.rpdos, &nn.rpdos);
-    pdos(o, "TPDO", 0x1800, &on.tpdos, &nn.tpdos);
+    let ids = (on.node_id, nn.node_id);
+    pdos(o, ("RPDO", 0x1400), ids, &on.rpdos, &nn.rpdos);
+    pdos(o, ("TPDO", 0x1800), ids, &on.tpdos, &nn.tpdos);
     error_control(o, old, new);
 }
 
@@ -148,8 +149,9 @@ fn mapping(pdo: &Pdo) -> Val {
     ))
 }
 
-/// One direction's PDOs, by number.
-fn pdos(o: &mut Out, prefix: &str, comm_base: u16, old: &[Pdo], new: &[Pdo]) {
+/// One direction's PDOs, by number. `ids`: the node's old and new id (a
+/// COB-ID that moves with it says so).
+fn pdos(o: &mut Out, (prefix, comm_base): (&str, u16), ids: (u8, u8), old: &[Pdo], new: &[Pdo]) {
     let mut numbers: Vec<u16> = old.iter().chain(new).map(|p| p.number).collect();
     numbers.sort_unstable();
     numbers.dedup();
@@ -211,10 +213,13 @@ fn pdos(o: &mut Out, prefix: &str, comm_base: u16, old: &[Pdo], new: &[Pdo]) {
             );
         }
         if p.cob_id != n.cob_id {
+            let with_id = ids.0 != ids.1
+                && i64::from(n.cob_id) - i64::from(p.cob_id) == i64::from(ids.1) - i64::from(ids.0);
             let message = format!(
-                "{name} COB-ID {} → {}",
+                "{name} COB-ID {} → {}{}",
                 hex(p.cob_id.into()),
-                hex(n.cob_id.into())
+                hex(n.cob_id.into()),
+                if with_id { " (with the node id)" } else { "" }
             );
             o.push(
                 Wiring::PdoCobIdMoved,
