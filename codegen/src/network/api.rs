@@ -4,7 +4,7 @@
 //! (docs/api-listing.md), each prefixed by its section:
 //!
 //! - `master → network → node_id=… → baudrate=… → sync_period=… → …`;
-//! - per node, in the bus's order: `NODE → node → id=… → vendor=… → …`,
+//! - per node, in the bus's order: `NODE → node → id=… → device_type=… → …`,
 //!   then its configured PDOs `NODE → rpdo 1 → cob_id=… → … → mapping`,
 //!   then its device listing, each line prefixed by `NODE`.
 
@@ -16,7 +16,6 @@ use super::model::{Bus, MasterSection};
 use crate::diag::Diagnostics;
 use crate::r#gen::rust::od_plan::{DeviceNames, device_names};
 use crate::r#gen::rust::{self, ApiListing};
-use crate::ir::Device;
 
 /// The listing of a configured network; its errors are those of
 /// generating each node's device (with `options.strict`, warnings too).
@@ -34,7 +33,7 @@ pub fn api_listing(
         };
         let prefix = node_column(&node.name);
         let names = device_names(&slave.device);
-        text.push_str(&node_line(&prefix, node, &slave.device));
+        text.push_str(&node_line(&prefix, node));
         for (direction, pdos) in [("rpdo", &node.rpdos), ("tpdo", &node.tpdos)] {
             for pdo in pdos {
                 text.push_str(&pdo_line(&prefix, direction, pdo, &names));
@@ -132,15 +131,17 @@ fn master_line(m: &MasterSection) -> String {
     )
 }
 
-fn node_line(prefix: &str, node: &Node, device: &Device) -> String {
-    let id = &device.identity;
-    let n = |v: Option<u32>| v.map_or("-".to_string(), hex);
+/// The node's id, the identity the master checks (0: not checked) and its
+/// error control.
+fn node_line(prefix: &str, node: &Node) -> String {
     format!(
-        "{prefix}\tnode\tid={}\tvendor={}\tproduct={}\trevision={}\theartbeat_producer={}\theartbeat_consumer={}\n",
+        "{prefix}\tnode\tid={}\tdevice_type={}\tvendor={}\tproduct={}\trevision={}\tserial={}\theartbeat_producer={}\theartbeat_consumer={}\n",
         node.node_id,
-        n(id.vendor_number),
-        n(id.product_number),
-        n(id.revision_number),
+        hex(node.device_type),
+        hex(node.vendor_id),
+        hex(node.product_code),
+        hex(node.revision_number),
+        hex(node.serial_number),
         node.heartbeat_producer,
         node.heartbeat_consumer
     )
