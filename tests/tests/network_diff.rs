@@ -102,6 +102,7 @@ fn every_wiring_change_of_the_fixture_is_found() {
             .any(|c| matches!(c.kind, NetKind::Device(_)) && c.rust_path.is_some())
     );
     insta::assert_snapshot!("network_diff_text", render::text(&changes));
+    docs_block_is(&render::text(&changes));
     insta::assert_snapshot!(
         "network_diff_json",
         render::json("old/bus.yml", "new/bus.yml", &changes)
@@ -120,4 +121,24 @@ fn the_api_listing_of_each_side() {
             .unwrap_or_else(|d| panic!("{side}: {}", d.render()));
         insta::assert_snapshot!(format!("network_api_{side}"), listing.text);
     }
+}
+
+/// The block after `<!-- output: network-diff-text -->` in docs/network.md
+/// is `text`; `UPDATE_DOCS=1` rewrites it instead.
+fn docs_block_is(text: &str) {
+    let path = eds2rust_tests::workspace_root().join("docs/network.md");
+    let doc = std::fs::read_to_string(&path).expect("docs/network.md");
+    let marker = "<!-- output: network-diff-text -->\n```text\n";
+    let start = doc.find(marker).expect("the marker in docs/network.md") + marker.len();
+    let end = start + doc[start..].find("```\n").expect("the block's end");
+    if std::env::var_os("UPDATE_DOCS").is_some() {
+        let updated = format!("{}{text}{}", &doc[..start], &doc[end..]);
+        std::fs::write(&path, updated).unwrap();
+        return;
+    }
+    assert_eq!(
+        &doc[start..end],
+        text,
+        "docs/network.md does not show the real output; run with UPDATE_DOCS=1 and review"
+    );
 }
