@@ -72,23 +72,19 @@ pub fn api_listing_file(
     let Some(bus) = loaded.bus.filter(|_| !diagnostics.has_errors()) else {
         return Err(diagnostics);
     };
-    let (configured, configure_diagnostics) = super::configure(&bus);
-    diagnostics.extend(configure_diagnostics);
-    let options = rust::Options {
-        strict: read.strict,
-        ..rust::Options::default()
-    };
-    let result = if diagnostics.has_errors() {
-        Err(Diagnostics::new())
-    } else {
-        api_listing(&bus, &configured, &options)
-    };
-    let (text, more) = match result {
+    let (configured, more) = super::configure(&bus);
+    diagnostics.extend(more);
+    diagnostics.apply_levels(&read.levels, read.strict);
+    if diagnostics.has_errors() {
+        diagnostics.sort();
+        return Err(diagnostics);
+    }
+    let (text, mut more) = match api_listing(&bus, &configured, &rust::Options::default()) {
         Ok(listing) => (Some(listing.text), listing.warnings),
         Err(errors) => (None, errors),
     };
+    more.apply_levels(&read.levels, read.strict);
     diagnostics.extend(more);
-    diagnostics.apply_levels(&read.levels, read.strict);
     diagnostics.sort();
     match text {
         Some(text) if !diagnostics.has_errors() => Ok(ApiListing {
