@@ -179,3 +179,56 @@ fn pdo_line(prefix: &str, direction: &str, pdo: &Pdo, names: &DeviceNames) -> St
         mapping(pdo, names)
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ir::pdo::MappedObject;
+
+    #[test]
+    fn node_names_that_are_not_one_word_are_quoted() {
+        assert_eq!(node_column("axis_1"), "axis_1");
+        assert_eq!(node_column("prbt-joint.2"), "prbt-joint.2");
+        assert_eq!(node_column("a\tb"), "\"a\\tb\"");
+        assert_eq!(node_column("two words"), "\"two words\"");
+        assert_eq!(node_column(""), "\"\"");
+    }
+
+    #[test]
+    fn a_mapping_lists_bit_ranges_gaps_and_unknown_entries() {
+        let pdo = Pdo {
+            number: 1,
+            cob_id: 0x181,
+            transmission: 1,
+            inhibit_time: 0,
+            event_timer: 0,
+            sync_start: 0,
+            mapping: vec![
+                MappedObject {
+                    index: 0x6041,
+                    subindex: 0,
+                    bits: 16,
+                },
+                MappedObject {
+                    index: 0x0005,
+                    subindex: 0,
+                    bits: 8,
+                },
+                MappedObject {
+                    index: 0x2000,
+                    subindex: 3,
+                    bits: 32,
+                },
+            ],
+            spot: None,
+        };
+        assert_eq!(
+            mapping(&pdo, &DeviceNames::default()),
+            "0x6041.0@0..16, dummy 0x0005@16..24, 0x2000.3@24..56"
+        );
+        assert_eq!(
+            pdo_line("axis", "tpdo", &pdo, &DeviceNames::default()),
+            "axis\ttpdo 1\tcob_id=0x181\ttransmission=1\tinhibit_time=0\tevent_timer=0\tsync_start=0\t0x6041.0@0..16, dummy 0x0005@16..24, 0x2000.3@24..56\n"
+        );
+    }
+}
