@@ -22,9 +22,14 @@ fn fixture(side: &str) -> PathBuf {
 
 /// Reads and configures one side; no errors, no warnings.
 fn load(side: &str) -> (Bus, Configured) {
-    let path = fixture(side);
-    assert!(eds2rust::network::is_bus_file(&path), "{side}: a bus file");
-    let loaded = eds2rust::network::read_file(&path, &Options::default());
+    load_path(&fixture(side), side, false)
+}
+
+/// Reads and configures a bus file; no errors (and, unless
+/// `warnings_allowed`, no warnings of the configuration).
+fn load_path(path: &std::path::Path, side: &str, warnings_allowed: bool) -> (Bus, Configured) {
+    assert!(eds2rust::network::is_bus_file(path), "{side}: a bus file");
+    let loaded = eds2rust::network::read_file(path, &Options::default());
     let bus = loaded
         .bus
         .unwrap_or_else(|| panic!("{side}: {}", loaded.diagnostics.render()));
@@ -35,7 +40,7 @@ fn load(side: &str) -> (Bus, Configured) {
     );
     let (configured, diagnostics) = eds2rust::network::configure(&bus);
     assert!(
-        diagnostics.error_count() == 0 && diagnostics.warning_count() == 0,
+        diagnostics.error_count() == 0 && (warnings_allowed || diagnostics.warning_count() == 0),
         "{side}: {}",
         diagnostics.render()
     );
@@ -55,6 +60,35 @@ fn a_network_against_itself_has_no_changes() {
     for side in ["old", "new"] {
         let n = load(side);
         assert_eq!(changes(&n, &n), Vec::new(), "{side}");
+    }
+}
+
+/// The corpus networks (../shared/network-corpus) against themselves: no
+/// changes; their API listings list every node and its PDOs.
+#[test]
+fn corpus_networks_against_themselves() {
+    let Some(shared) = eds2rust_tests::shared_dir() else {
+        eds2rust_tests::not_run(
+            "network diff of the corpus networks: ../shared/network-corpus is not beside this checkout",
+        );
+        return;
+    };
+    for name in ["prbt_pilz6", "trinamic_pd42"] {
+        let path = shared.join("network-corpus").join(name).join("bus.yml");
+        let n = load_path(&path, name, true);
+        assert_eq!(changes(&n, &n), Vec::new(), "{name}");
+        let listing = eds2rust::network::api::api_listing(&n.0, &n.1, &Default::default())
+            .unwrap_or_else(|d| panic!("{name}: {}", d.render()));
+        for node in &n.1.nodes {
+            let line = format!("\n{}\tnode\tid={}\t", node.name, node.node_id);
+            assert!(listing.text.contains(&line), "{name}: {line:?}");
+            let pdos = listing
+                .text
+                .lines()
+                .filter(|l| l.starts_with(&format!("{}\ttpdo ", node.name)))
+                .count();
+            assert_eq!(pdos, node.tpdos.len(), "{name}: {}", node.name);
+        }
     }
 }
 
