@@ -6,7 +6,9 @@
 //! - `master → network → node_id=… → baudrate=… → sync_period=… → …`;
 //! - per node, in the bus's order: `NODE → node → id=… → device_type=… → …`,
 //!   then its configured PDOs `NODE → rpdo 1 → cob_id=… → … → mapping`,
-//!   then its device listing, each line prefixed by `NODE`.
+//!   then the listing of its device as this network configures it
+//!   ([`super::configured::configured_device`]: the `pdo::` lines are the
+//!   network's PDOs), each line prefixed by `NODE`.
 
 use std::fmt::Write;
 use std::path::Path;
@@ -39,7 +41,10 @@ pub fn api_listing(
                 text.push_str(&pdo_line(&prefix, direction, pdo, &names));
             }
         }
-        match rust::api_listing(&slave.device, options) {
+        // The node's device with this network's PDOs, as the generated
+        // network makes its module (`pdo::` lines are the network's PDOs).
+        let device = super::configured::configured_device(&slave.device, node);
+        match rust::api_listing(&device, options) {
             Ok(listing) => {
                 warnings.extend(listing.warnings);
                 for line in listing.text.lines() {
