@@ -160,7 +160,7 @@ fn generate_configured(
             {
                 Some(e) => pdos.push(NodePdo {
                     pdo: e.clone(),
-                    cob_id: pdo.cob_id,
+                    cob_id: pdo.can_id().0,
                     transmission: pdo.transmission,
                 }),
                 None => diagnostics.push(error_at(

@@ -67,7 +67,10 @@ pub struct Node {
 pub struct Pdo {
     /// 1-based PDO number on the node.
     pub number: u16,
-    /// COB-ID (11 or 29 bit, flags removed).
+    /// The COB-ID entry's value as configured (sub 1 of the communication
+    /// parameter): bit 30 (no RTR) and bit 29 (29-bit identifier) kept, bit
+    /// 31 clear (only valid PDOs are listed). [`Pdo::can_id`] gives the
+    /// identifier.
     pub cob_id: u32,
     pub transmission: u8,
     pub inhibit_time: u16,
@@ -76,6 +79,26 @@ pub struct Pdo {
     pub mapping: Vec<MappedObject>,
     /// Where the bus file configures it (`None`: the device file's default).
     pub spot: Option<Spot>,
+}
+
+impl Pdo {
+    /// The CAN identifier the PDO is sent on, and whether it is a 29-bit one.
+    pub fn can_id(&self) -> (u32, bool) {
+        can_id(self.cob_id)
+    }
+}
+
+/// The CAN identifier of a COB-ID entry's value (CiA 301: bits 0–28 the
+/// identifier, bit 29 set for a 29-bit one; bits 30 and 31 are flags), and
+/// whether it is a 29-bit one. An identifier above 0x7FF without bit 29 is
+/// taken as a 29-bit one too.
+pub fn can_id(raw: u32) -> (u32, bool) {
+    let id = raw & 0x1FFF_FFFF;
+    if raw & 0x2000_0000 != 0 || id > 0x7FF {
+        (id, true)
+    } else {
+        (id, false)
+    }
 }
 
 /// One entry of a concise DCF.

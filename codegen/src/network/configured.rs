@@ -93,9 +93,9 @@ fn write_mapping(object: &mut Object, mapping: &[MappedObject]) {
 }
 
 fn write_communication(comm: &mut Object, direction: PdoDirection, pdo: &Pdo) {
-    // The COB-ID entry: the identifier, bit 29 for a 29-bit one.
-    let frame = if pdo.cob_id > 0x7FF { 1 << 29 } else { 0 };
-    let cob_id = pdo.cob_id | frame;
+    // The COB-ID entry as configured (bits 29 and 30 as the network has them).
+    let (_, extended) = pdo.can_id();
+    let cob_id = pdo.cob_id | if extended { 1 << 29 } else { 0 };
     set(comm, 1, cob_id.into(), format!("0x{cob_id:X}"));
     set(
         comm,

@@ -20,17 +20,7 @@ pub(super) const RESTRICTED: &[(u32, u32, &str)] = &[
     (0x780, 0x7FF, "reserved, LSS"),
 ];
 
-/// A COB-ID as the CAN identifier it sends: the 29-bit identifier when
-/// bit 29 (frame) is set or the value does not fit 11 bits, else the
-/// 11-bit one; flags (bits 31, 30) dropped.
-pub(super) fn can_id(raw: u32) -> (u32, bool) {
-    let id = raw & 0x1FFF_FFFF;
-    if raw & 0x2000_0000 != 0 || id > 0x7FF {
-        (id, true)
-    } else {
-        (id, false)
-    }
-}
+pub(super) use crate::network::config::can_id;
 
 /// One sender of one COB-ID.
 struct Producer {
