@@ -60,6 +60,14 @@ pub struct Pdo {
     pub inhibit_time: u16,
     pub event_timer: u16,
     pub sync_start: u8,
+    /// `event_deadline` (ms) as the bus file gives it (0 when absent): for
+    /// a slave's TPDO, the deadline of the master's RPDO that mirrors it.
+    pub event_deadline: u16,
+    /// False for a PDO that the bus file disables (`enabled: false`) but
+    /// that dcfgen keeps in master.dcf, because the device file's COB-ID
+    /// is valid and its mapping is not empty: master.dcf mirrors it under
+    /// its number, not valid.
+    pub enabled: bool,
     pub mapping: Vec<MappedObject>,
     /// Where the bus file configures it (`None`: the device file's default).
     pub spot: Option<Spot>,

@@ -4,6 +4,7 @@
 //! DCFs.
 
 pub mod config;
+pub mod dcf;
 pub mod model;
 
 use std::path::{Path, PathBuf};

@@ -79,7 +79,11 @@ pub struct BusOptions {
 
 impl Default for BusOptions {
     fn default() -> Self {
-        BusOptions { dcf_path: String::new(), heartbeat_multiplier: 3.0, retry_factor: 3 }
+        BusOptions {
+            dcf_path: String::new(),
+            heartbeat_multiplier: 3.0,
+            retry_factor: 3,
+        }
     }
 }
 
