@@ -160,6 +160,42 @@ pub const RULES: &[Rule] = &[
         "an input file above the size limit (--max-input-size)",
     ),
     rule(
+        "net::auto-cob-id",
+        "a PDO with cob_id: auto when no 11-bit COB-ID is left (0x680–0x6DF used up)",
+    ),
+    rule(
+        "net::heartbeat-and-guarding",
+        "a node with both a heartbeat producer time and node guarding",
+    ),
+    rule(
+        "net::identity-differs",
+        "a bus file's revision or serial number that differs from the device file's",
+    ),
+    rule(
+        "net::missing-object",
+        "a bus file setting whose object the device file lacks (0x1012, 0x1016, 0x1017, 0x100C, 0x100D, 0x1029, 0x1F56, 0x1011)",
+    ),
+    rule(
+        "net::no-node-id",
+        "a slave without a node id, left out of the network",
+    ),
+    rule(
+        "net::no-such-pdo",
+        "an rpdo/tpdo number the device file has no PDO for",
+    ),
+    rule(
+        "net::not-writable",
+        "a configuration write to an entry that is not writable",
+    ),
+    rule(
+        "net::unknown-object",
+        "a write or mapping of an object or sub-object the device file lacks",
+    ),
+    rule(
+        "net::value-range",
+        "a configuration value that does not fit its entry's data type",
+    ),
+    rule(
         "table::array-type",
         "an ARRAY whose subs do not share one type",
     ),
@@ -366,7 +402,7 @@ mod tests {
                     let Some((area, name)) = word.split_once("::") else {
                         continue;
                     };
-                    let is_code = ["build", "eds", "gen", "input", "table"].contains(&area)
+                    let is_code = ["build", "eds", "gen", "input", "net", "table"].contains(&area)
                         && !name.is_empty()
                         && name
                             .bytes()

@@ -34,6 +34,12 @@ pub struct Node {
     /// The PDOs the node transmits (its TPDOs), valid and mapped ones only,
     /// by number.
     pub tpdos: Vec<Pdo>,
+    /// The PDOs the bus file disables (`enabled: false`) whose device-file
+    /// COB-ID was valid and whose mapping is not empty, by number: dcfgen
+    /// keeps them valid in master.dcf; `net dcf` mirrors them there under
+    /// their numbers, not valid. Not part of the running network.
+    pub disabled_rpdos: Vec<Pdo>,
+    pub disabled_tpdos: Vec<Pdo>,
     /// The node's concise DCF (`NAME.bin`) in dcfgen's order; empty when
     /// dcfgen writes no file for it.
     pub concise: Vec<ConciseEntry>,
@@ -47,6 +53,20 @@ pub struct Node {
     /// The COB-IDs of the node's EMCY (0x1014, bit 31 kept) and TIME (0x1012).
     pub emcy_cob_id: u32,
     pub time_cob_id: u32,
+    /// Identity as the master checks it (0x1000, 0x1018 sub 1–4, from the
+    /// device file's `[DeviceInfo]`/0x1018/`[DeviceComissioning]` and the
+    /// bus file's `revision_number`/`serial_number`); 0 means not checked.
+    pub device_type: u32,
+    pub vendor_id: u32,
+    pub product_code: u32,
+    pub revision_number: u32,
+    pub serial_number: u32,
+    /// Where the master finds this node's files at run time (`dcf_path`).
+    pub dcf_path: String,
+    /// The node's concise DCF as the master names it in 0x1F22
+    /// (`<dcf_path>/<name>.bin`, or the bus file's `configuration_file`);
+    /// empty when there is none.
+    pub configuration_file: String,
 }
 
 /// One PDO as configured.
@@ -60,14 +80,13 @@ pub struct Pdo {
     pub inhibit_time: u16,
     pub event_timer: u16,
     pub sync_start: u8,
-    /// `event_deadline` (ms) as the bus file gives it (0 when absent): for
-    /// a slave's TPDO, the deadline of the master's RPDO that mirrors it.
-    pub event_deadline: u16,
-    /// False for a PDO that the bus file disables (`enabled: false`) but
-    /// that dcfgen keeps in master.dcf, because the device file's COB-ID
-    /// is valid and its mapping is not empty: master.dcf mirrors it under
-    /// its number, not valid.
-    pub enabled: bool,
+    /// Sub 5 of the master's mirror of this PDO in master.dcf: for a
+    /// slave's RPDO (a master TPDO) the bus file's `event_timer`, for a
+    /// slave's TPDO (a master RPDO) its `event_deadline`; 0 when absent.
+    pub master_event_timer: u16,
+    /// Sub 6 of the master TPDO that mirrors a slave's RPDO: the bus file's
+    /// `sync_start` (0 when absent).
+    pub master_sync_start: u8,
     pub mapping: Vec<MappedObject>,
     /// Where the bus file configures it (`None`: the device file's default).
     pub spot: Option<Spot>,
@@ -87,6 +106,5 @@ pub struct ConciseEntry {
 /// Applies the bus file to every device as dcfgen does; what dcfgen warns
 /// about or refuses becomes a diagnostic naming the bus file, line and key.
 pub fn configure(bus: &Bus) -> (Configured, Diagnostics) {
-    let _ = bus;
-    todo!("net-dcf helper")
+    super::configure::run(bus)
 }

@@ -4,8 +4,11 @@
 //! DCFs.
 
 pub mod config;
+mod configure;
 pub mod dcf;
 pub mod model;
+mod pdo_config;
+mod view;
 
 use std::path::{Path, PathBuf};
 

@@ -267,3 +267,33 @@ pub struct SdoItem {
     /// `value` (default 0), packed by the entry's data type.
     pub value: i128,
 }
+
+impl Spot {
+    /// The diagnostics location of this spot (line and key).
+    pub fn location(&self) -> crate::diag::Location {
+        crate::diag::Location {
+            line: (self.line > 0).then_some(self.line),
+            span: None,
+            section: None,
+            key: (!self.key.is_empty()).then(|| self.key.clone()),
+        }
+    }
+
+    /// A diagnostic about the value written here, in bus file `file`.
+    pub fn diagnostic(
+        &self,
+        file: &std::path::Path,
+        severity: crate::diag::Severity,
+        code: &'static str,
+        message: String,
+    ) -> crate::diag::Diagnostic {
+        crate::diag::Diagnostic {
+            severity,
+            code,
+            file: file.display().to_string(),
+            location: self.location(),
+            message,
+            notes: Vec::new(),
+        }
+    }
+}

@@ -6,12 +6,12 @@
 //! slave RPDO (numbered in slave order), the 0x2000/0x2200 objects they
 //! map, and with `remote_pdo` the remote PDO mappings (0x5800–0x5FFF).
 
-use crate::ir::{DataType, Device, ObjectKind, ValueKind};
+use crate::ir::{DataType, Device, ObjectKind};
 use crate::network::config::{Configured, Node, Pdo};
 use crate::network::model::{Bus, SlaveSection};
 
 use super::ini::{Ini, hex};
-use super::{Difference, consumer_heartbeat_time, upload_file};
+use super::{Difference, consumer_heartbeat_time};
 
 /// Sub 0's name in a record (the PDO parameters write it lower-case).
 const HIGHEST: &str = "Highest sub-index supported";
@@ -49,8 +49,9 @@ impl Side {
 /// One master PDO: the slave PDO it mirrors.
 struct Mirror<'a> {
     node: &'a Node,
-    slave: &'a SlaveSection,
     pdo: &'a Pdo,
+    /// False for a PDO the bus file disables (see [`Node::disabled_tpdos`]).
+    enabled: bool,
 }
 
 /// The master PDOs of one side with where each mapped slave object lands
@@ -83,12 +84,15 @@ impl<'a> MasterPdos<'a> {
                 continue;
             };
             // A slave's TPDOs are the master's RPDOs and the other way round.
-            let list = match side {
-                Side::Rx => &node.tpdos,
-                Side::Tx => &node.rpdos,
+            let (running, disabled) = match side {
+                Side::Rx => (&node.tpdos, &node.disabled_tpdos),
+                Side::Tx => (&node.rpdos, &node.disabled_rpdos),
             };
+            let mut list: Vec<(&Pdo, bool)> = running.iter().map(|p| (p, true)).collect();
+            list.extend(disabled.iter().map(|p| (p, false)));
+            list.sort_by_key(|(p, _)| p.number);
             let mut seen: Vec<((u16, u8), u32)> = Vec::new();
-            for pdo in list {
+            for (pdo, enabled) in list {
                 let k = pdos.mirrors.len() as u32;
                 let (mut values, mut objects) = (Vec::new(), Vec::new());
                 for mapped in &pdo.mapping {
@@ -97,14 +101,13 @@ impl<'a> MasterPdos<'a> {
                         Some((_, value)) => *value,
                         None => {
                             let info = mapped_info(&slave.device, mapped.index, mapped.subindex);
-                            let bits = type_bits(info.data_type).unwrap_or(mapped.bits);
                             objects.push(MappedInfo {
                                 name: format!("{}: {}", slave.name, info.name),
                                 data_type: info.data_type,
                             });
                             let value = (side.object_base() + k) << 16
                                 | (objects.len() as u32 & 0xFF) << 8
-                                | u32::from(bits);
+                                | u32::from(mapped.bits);
                             seen.push((key, value));
                             value
                         }
@@ -113,7 +116,7 @@ impl<'a> MasterPdos<'a> {
                 }
                 pdos.values.push(values);
                 pdos.objects.push(objects);
-                pdos.mirrors.push(Mirror { node, slave, pdo });
+                pdos.mirrors.push(Mirror { node, pdo, enabled });
             }
         }
         pdos
@@ -170,27 +173,18 @@ fn mapped_info(device: &Device, index: u16, sub_index: u8) -> MappedInfo {
     }
 }
 
-/// The bits a PDO maps of a value of type `code`.
-fn type_bits(code: u16) -> Option<u8> {
-    match DataType::from_code(code).value_kind()? {
-        ValueKind::Integer { bits, .. } | ValueKind::Real { bits } => u8::try_from(bits).ok(),
-        _ => None,
-    }
-}
-
 /// The COB-ID of a mirrored PDO in the master: the slave's, not valid when
 /// the bus file disables the slave's PDO.
-fn master_cob_id(pdo: &Pdo, differences: &mut Vec<Difference>, index: u32, node: &Node) -> u32 {
-    let mut cob_id = pdo.cob_id;
-    if !pdo.enabled {
-        cob_id |= 0x8000_0000;
-        differences.push(Difference::DisabledPdoInvalid {
-            index: index as u16,
-            node: node.name.clone(),
-            number: pdo.number,
-        });
+fn master_cob_id(mirror: &Mirror, index: u32, differences: &mut Vec<Difference>) -> u32 {
+    if mirror.enabled {
+        return mirror.pdo.cob_id;
     }
-    cob_id
+    differences.push(Difference::DisabledPdoInvalid {
+        index: index as u16,
+        node: mirror.node.name.clone(),
+        number: mirror.pdo.number,
+    });
+    mirror.pdo.cob_id | 0x8000_0000
 }
 
 /// The whole master.dcf text, and where it deliberately differs from
@@ -204,10 +198,18 @@ pub(super) fn master_dcf(
     let rx = MasterPdos::new(bus, configured, Side::Rx);
     let tx = MasterPdos::new(bus, configured, Side::Tx);
     let mut differences = Vec::new();
-    let uploads: Vec<(u8, String)> = configured
-        .nodes
-        .iter()
-        .filter_map(|node| Some((node.node_id, upload_file(bus, node, &mut differences)?)))
+    let uploads: Vec<(u8, &str)> = slaves(bus, configured)
+        .filter(|(node, _)| !node.configuration_file.is_empty())
+        .map(|(node, slave)| {
+            if let Some(file) = &slave.configuration_file {
+                differences.push(Difference::ConfigurationFile {
+                    node: node.name.clone(),
+                    node_id: node.node_id,
+                    file: file.value.clone(),
+                });
+            }
+            (node.node_id, node.configuration_file.as_str())
+        })
         .collect();
     let software: Vec<(u8, &str)> = slaves(bus, configured)
         .filter_map(|(node, slave)| {
@@ -468,7 +470,7 @@ pub(super) fn master_dcf(
 
     for (k, mirror) in rx.mirrors.iter().enumerate() {
         let index = 0x1400 + k as u32;
-        let cob_id = master_cob_id(mirror.pdo, &mut differences, index, mirror.node);
+        let cob_id = master_cob_id(mirror, index, &mut differences);
         record(
             &mut ini,
             index,
@@ -511,14 +513,14 @@ pub(super) fn master_dcf(
             "event-timer",
             0x0006,
             "rw",
-            Some(mirror.pdo.event_deadline.to_string()),
+            Some(mirror.pdo.master_event_timer.to_string()),
         );
     }
     mappings(&mut ini, &rx);
     for (k, mirror) in tx.mirrors.iter().enumerate() {
         let index = 0x1800 + k as u32;
         let pdo = mirror.pdo;
-        let cob_id = master_cob_id(pdo, &mut differences, index, mirror.node);
+        let cob_id = master_cob_id(mirror, index, &mut differences);
         record(
             &mut ini,
             index,
@@ -561,7 +563,7 @@ pub(super) fn master_dcf(
             "event timer",
             0x0006,
             "rw",
-            Some(pdo.event_timer.to_string()),
+            Some(pdo.master_event_timer.to_string()),
         );
         sub(
             &mut ini,
@@ -570,22 +572,13 @@ pub(super) fn master_dcf(
             "SYNC start value",
             0x0005,
             "rw",
-            Some(pdo.sync_start.to_string()),
+            Some(pdo.master_sync_start.to_string()),
         );
     }
     mappings(&mut ini, &tx);
 
     if !uploads.is_empty() {
-        files_array(
-            &mut ini,
-            0x1F22,
-            "Concise DCF",
-            "Node-ID",
-            &uploads
-                .iter()
-                .map(|(n, f)| (*n, f.as_str()))
-                .collect::<Vec<_>>(),
-        );
+        files_array(&mut ini, 0x1F22, "Concise DCF", "Node-ID", &uploads);
     }
     array(&mut ini, 0x1F25, "Configuration request", 0x0005, "wo", 127);
     array(
@@ -624,32 +617,33 @@ pub(super) fn master_dcf(
         .collect();
     values(&mut ini, 0x1F81, assignment);
     array(&mut ini, 0x1F82, "Request NMT", 0x0005, "rw", 127);
-    let identities = [
-        (
-            0x1F84,
-            "Device type identification",
-            IdentityItem::DeviceType,
-        ),
-        (0x1F85, "Vendor identification", IdentityItem::Vendor),
-        (0x1F86, "Product code", IdentityItem::Product),
+    let has_product_sub = |slave: &SlaveSection| {
+        slave
+            .device
+            .objects
+            .get(&0x1018)
+            .is_some_and(|o| o.entries.contains_key(&2))
+    };
+    let identities: [(u32, &str, fn(&Node) -> u32); 3] = [
+        (0x1F84, "Device type identification", |n| n.device_type),
+        (0x1F85, "Vendor identification", |n| n.vendor_id),
+        (0x1F86, "Product code", |n| n.product_code),
     ];
-    for (index, name, item) in identities {
+    for (index, name, value_of) in identities {
         array(&mut ini, index, name, 0x0007, "rw", 127);
-        let entries = slaves(bus, configured)
-            .filter_map(|(node, slave)| {
-                let value = expected_identity(&slave.device, node.node_id, item)?;
-                (value != 0).then(|| (node.node_id.to_string(), hex(value, 8)))
-            })
-            .collect();
-        if let IdentityItem::Product = item {
-            for (node, slave) in slaves(bus, configured) {
-                let listed = expected_identity(&slave.device, node.node_id, item).is_some();
-                if !listed && slave.device.identity.product_number.is_some_and(|p| p != 0) {
-                    differences.push(Difference::UnlistedProductCode {
-                        node: node.name.clone(),
-                    });
-                }
+        let mut entries = Vec::new();
+        for (node, slave) in slaves(bus, configured) {
+            let value = value_of(node);
+            if value == 0 {
+                continue;
             }
+            if index == 0x1F86 && !has_product_sub(slave) {
+                differences.push(Difference::UnlistedProductCode {
+                    node: node.name.clone(),
+                });
+                continue;
+            }
+            entries.push((node.node_id.to_string(), hex(value, 8)));
         }
         values(&mut ini, index, entries);
     }
@@ -757,35 +751,6 @@ fn slave_assignment(bus: &Bus, node: &Node, slave: &SlaveSection) -> u32 {
         | u32::from(node.guard_time) << 16
 }
 
-#[derive(Clone, Copy)]
-enum IdentityItem {
-    DeviceType,
-    Vendor,
-    Product,
-}
-
-/// The identity the master expects of a slave (0x1F84–0x1F86): the
-/// device file's `[DeviceInfo]` number where it gives one, else its 0x1018
-/// value; a product code only when the device has 0x1018/2.
-fn expected_identity(device: &Device, node_id: u8, item: IdentityItem) -> Option<u32> {
-    let value = |index: u16, sub: u8| -> Option<u32> {
-        let entry = device.objects.get(&index)?.entries.get(&sub)?;
-        let literal = entry.parameter_value.as_ref().or(entry.default.as_ref())?;
-        match literal.resolve(Some(node_id)) {
-            crate::ir::Value::Integer(v) => u32::try_from(v).ok(),
-            _ => None,
-        }
-    };
-    match item {
-        IdentityItem::DeviceType => Some(value(0x1000, 0).unwrap_or(0)),
-        IdentityItem::Vendor => device.identity.vendor_number.or_else(|| value(0x1018, 1)),
-        IdentityItem::Product => {
-            device.objects.get(&0x1018)?.entries.get(&2)?;
-            device.identity.product_number.or_else(|| value(0x1018, 2))
-        }
-    }
-}
-
 /// The 0x16xx/0x1Axx mapping arrays of one side.
 fn mappings(ini: &mut Ini, pdos: &MasterPdos) {
     let title = format!("{} mapping parameter", pdos.side.name());
@@ -830,12 +795,7 @@ fn remote(ini: &mut Ini, pdos: &MasterPdos, number_base: u32, mapping_base: u32,
             .mapping
             .iter()
             .enumerate()
-            .map(|(i, mapped)| {
-                let info = mapped_info(&mirror.slave.device, mapped.index, mapped.subindex);
-                let bits = type_bits(info.data_type).unwrap_or(mapped.bits);
-                let raw = crate::ir::pdo::MappedObject { bits, ..*mapped }.raw();
-                ((i + 1).to_string(), hex(raw, 8))
-            })
+            .map(|(i, mapped)| ((i + 1).to_string(), hex(mapped.raw(), 8)))
             .collect();
         values(ini, index, entries);
     }
