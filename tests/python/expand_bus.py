@@ -1,0 +1,44 @@
+"""Writes a bus file as ros2_canopen hands it to lely's dcfgen.
+
+dcfgen does not know ros2_canopen's `defaults:`/`nodes:`: before calling it,
+ros2_canopen turns every entry of `nodes:` into a slave section with the
+keys of `defaults:` put over the node's own (a dict update, so the defaults
+win) and dumps the file with its keys sorted (so the slaves, which number
+the master's PDOs, come in name order). A file without `nodes:` is dcfgen's
+own format and is written as read.
+
+usage: expand_bus.py BUS_YML OUT_YML
+"""
+
+import sys
+
+import yaml
+
+
+def expand(cfg):
+    if "nodes" not in cfg:
+        return cfg, False
+    defaults = cfg.pop("defaults", None) or {}
+    nodes = cfg.pop("nodes") or {}
+    for name, node in nodes.items():
+        slave = dict(node or {})
+        slave.update(defaults)
+        cfg[name] = slave
+    return cfg, True
+
+
+def main():
+    source, target = sys.argv[1], sys.argv[2]
+    with open(source, "r") as f:
+        cfg = yaml.safe_load(f)
+    cfg, expanded = expand(cfg)
+    with open(target, "w") as f:
+        if expanded:
+            yaml.safe_dump(cfg, f, sort_keys=True)
+        else:
+            with open(source, "r") as original:
+                f.write(original.read())
+
+
+if __name__ == "__main__":
+    main()
