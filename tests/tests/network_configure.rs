@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 use std::path::Path;
 
 use eds2rust::input::{Options, read_device};
-use eds2rust::network::config::configure;
+use eds2rust::network::configure;
 use eds2rust::network::model::*;
 
 fn spot(key: &str) -> Spot {

@@ -4,10 +4,9 @@
 //! the effective heartbeat and guarding times. One implementation, used by
 //! `net dcf`, `net check`, the generated network and the network diff.
 
-use crate::diag::Diagnostics;
 use crate::ir::pdo::MappedObject;
 
-use super::model::{Bus, Spot};
+use super::model::Spot;
 
 /// The configured network.
 #[derive(Debug, Clone)]
@@ -101,10 +100,4 @@ pub struct ConciseEntry {
     pub data: Vec<u8>,
     /// The bus file's key that causes it, where there is one.
     pub spot: Option<Spot>,
-}
-
-/// Applies the bus file to every device as dcfgen does; what dcfgen warns
-/// about or refuses becomes a diagnostic naming the bus file, line and key.
-pub fn configure(bus: &Bus) -> (Configured, Diagnostics) {
-    super::configure::run(bus)
 }

@@ -1,4 +1,4 @@
-//! [`config::configure`](super::config::configure): each slave's bus
+//! [`configure`]: each slave's bus
 //! section applied to its device file as dcfgen applies it (identity,
 //! TIME, heartbeat, guarding, error behaviour, PDOs, the `sdo` list), then
 //! the master's part (heartbeat consumer entries on the slaves, the
@@ -11,7 +11,9 @@ use super::model::{AUTO_COB_ID_FIRST, At, Bus, MasterSection, SlaveSection, Spot
 use super::pdo_config::{INVALID, SlaveState};
 use super::view::{DeviceView, pack};
 
-pub(crate) fn run(bus: &Bus) -> (Configured, Diagnostics) {
+/// Applies the bus file to every device as dcfgen does; what dcfgen warns
+/// about or refuses becomes a diagnostic naming the bus file, line and key.
+pub fn configure(bus: &Bus) -> (Configured, Diagnostics) {
     let mut diagnostics = Diagnostics::new();
     let mut next_auto = AUTO_COB_ID_FIRST;
     let mut nodes = Vec::new();
@@ -132,51 +134,34 @@ fn configure_slave(
         "serial number",
     );
 
-    if let Some(t) = &slave.time_cob_id {
-        if t.value != node.time_cob_id {
-            optional_write(
-                state,
-                0x1012,
-                0,
-                i128::from(t.value),
-                &t.spot,
-                "time_cob_id",
-            );
-        }
-        node.time_cob_id = t.value;
-    }
-    if let Some(t) = &slave.heartbeat_producer {
-        if t.value != node.heartbeat_producer {
-            optional_write(
-                state,
-                0x1017,
-                0,
-                i128::from(t.value),
-                &t.spot,
-                "heartbeat_producer",
-            );
-        }
-        node.heartbeat_producer = t.value;
-    }
-    if let Some(t) = &slave.guard_time {
-        if t.value != node.guard_time {
-            optional_write(state, 0x100C, 0, i128::from(t.value), &t.spot, "guard_time");
-        }
-        node.guard_time = t.value;
-    }
-    if let Some(t) = &slave.life_time_factor {
-        if t.value != node.life_time_factor {
-            optional_write(
-                state,
-                0x100D,
-                0,
-                i128::from(t.value),
-                &t.spot,
-                "life_time_factor",
-            );
-        }
-        node.life_time_factor = t.value;
-    }
+    set_comm(
+        state,
+        &slave.time_cob_id,
+        &mut node.time_cob_id,
+        0x1012,
+        "time_cob_id",
+    );
+    set_comm(
+        state,
+        &slave.heartbeat_producer,
+        &mut node.heartbeat_producer,
+        0x1017,
+        "heartbeat_producer",
+    );
+    set_comm(
+        state,
+        &slave.guard_time,
+        &mut node.guard_time,
+        0x100C,
+        "guard_time",
+    );
+    set_comm(
+        state,
+        &slave.life_time_factor,
+        &mut node.life_time_factor,
+        0x100D,
+        "life_time_factor",
+    );
     if node.guard_time != 0 && node.life_time_factor != 0 && node.heartbeat_producer != 0 {
         let spot = slave
             .heartbeat_producer
@@ -267,24 +252,35 @@ fn identity_override(
     }
 }
 
-/// A write to a communication object the device may lack (then a warning,
-/// no write).
-fn optional_write(
+/// A communication setting (`key`, object `index` sub 0): written when it
+/// differs from the device's value; a device without the object gets a
+/// warning and no write.
+fn set_comm<T>(
     state: &mut SlaveState<'_>,
+    given: &Option<At<T>>,
+    current: &mut T,
     index: u16,
-    sub: u8,
-    value: i128,
-    spot: &Spot,
     key: &str,
-) {
-    if state.view.has_object(index) {
-        state.write(index, sub, value, spot);
-    } else {
-        let message = format!(
-            "`{key}` needs object 0x{index:04X}, which the device file lacks; the setting is not written"
-        );
-        state.report(spot, Severity::Warning, "net::missing-object", message);
+) where
+    T: Copy + PartialEq + Into<i128>,
+{
+    let Some(given) = given else { return };
+    if given.value != *current {
+        if state.view.has_object(index) {
+            state.write(index, 0, given.value.into(), &given.spot);
+        } else {
+            let message = format!(
+                "`{key}` needs object 0x{index:04X}, which the device file lacks; the setting is not written"
+            );
+            state.report(
+                &given.spot,
+                Severity::Warning,
+                "net::missing-object",
+                message,
+            );
+        }
     }
+    *current = given.value;
 }
 
 fn configure_pdos(

@@ -5,6 +5,7 @@
 
 pub mod config;
 mod configure;
+pub use configure::configure;
 pub mod dcf;
 pub mod model;
 mod pdo_config;
