@@ -8,6 +8,7 @@ the master's PDOs, come in name order). A file without `nodes:` is dcfgen's
 own format and is written as read.
 
 usage: expand_bus.py BUS_YML OUT_YML
+       expand_bus.py --check BUS_YML EXPANDED_YML  (exit 1 when they differ)
 """
 
 import sys
@@ -28,6 +29,14 @@ def expand(cfg):
 
 
 def main():
+    if sys.argv[1] == "--check":
+        with open(sys.argv[2], "r") as f:
+            cfg, _ = expand(yaml.safe_load(f))
+        with open(sys.argv[3], "r") as f:
+            expected = yaml.safe_load(f)
+        if cfg != expected:
+            sys.exit("the expansion of {} differs from {}".format(sys.argv[2], sys.argv[3]))
+        return
     source, target = sys.argv[1], sys.argv[2]
     with open(source, "r") as f:
         cfg = yaml.safe_load(f)

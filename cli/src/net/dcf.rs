@@ -84,13 +84,21 @@ pub(crate) fn run(args: DcfArgs) -> ExitCode {
 /// `master` would overwrite master.bin).
 fn check_names(files: &[OutputFile]) -> Result<(), String> {
     for (n, file) in files.iter().enumerate() {
-        let plain = Path::new(&file.name).file_name().is_some_and(|f| f == file.name.as_str())
+        let plain = Path::new(&file.name)
+            .file_name()
+            .is_some_and(|f| f == file.name.as_str())
             && !file.name.contains(['/', '\\']);
         if !plain {
-            return Err(format!("`{}` is not a plain file name; rename the slave", file.name));
+            return Err(format!(
+                "`{}` is not a plain file name; rename the slave",
+                file.name
+            ));
         }
         if files[..n].iter().any(|f| f.name == file.name) {
-            return Err(format!("two files would be named `{}`; rename the slave", file.name));
+            return Err(format!(
+                "two files would be named `{}`; rename the slave",
+                file.name
+            ));
         }
     }
     Ok(())
