@@ -46,3 +46,128 @@ impl Ini {
 pub(super) fn hex(value: impl Into<u64>, digits: usize) -> String {
     format!("0x{:0digits$X}", value.into())
 }
+
+/// Sub 0's name in a record (the PDO parameters write it lower-case).
+pub(super) const HIGHEST: &str = "Highest sub-index supported";
+pub(super) const HIGHEST_PDO: &str = "highest sub-index supported";
+
+/// A 0x1F22/0x1F58-like array of DOMAIN files per node id 1–127.
+pub(super) fn files_array(
+    ini: &mut Ini,
+    index: u32,
+    name: &str,
+    sub_name: &str,
+    files: &[(u8, &str)],
+) {
+    ini.section(format!("{index:04X}"))
+        .key("SubNumber", 128)
+        .key("ParameterName", name)
+        .key("ObjectType", "0x08");
+    sub(
+        ini,
+        index,
+        0,
+        HIGHEST,
+        0x0005,
+        "const",
+        Some("127".to_string()),
+    );
+    for node_id in 1..=127u8 {
+        sub(
+            ini,
+            index,
+            u32::from(node_id),
+            &format!("{sub_name} {node_id}"),
+            0x000F,
+            "ro",
+            None,
+        );
+        for (_, file) in files.iter().filter(|(n, _)| *n == node_id) {
+            ini.key("UploadFile", file);
+        }
+    }
+}
+
+pub(super) fn var<'a>(
+    ini: &'a mut Ini,
+    index: u32,
+    name: &str,
+    data_type: u32,
+    access: &str,
+    default: Option<String>,
+) -> &'a mut Ini {
+    ini.section(format!("{index:04X}"));
+    entry_keys(ini, name, data_type, access, default)
+}
+
+pub(super) fn entry_keys<'a>(
+    ini: &'a mut Ini,
+    name: &str,
+    data_type: u32,
+    access: &str,
+    default: Option<String>,
+) -> &'a mut Ini {
+    ini.key("ParameterName", name)
+        .key("DataType", hex(data_type, 4))
+        .key("AccessType", access);
+    if let Some(default) = default {
+        ini.key("DefaultValue", default);
+    }
+    ini
+}
+
+/// A RECORD's head and its sub 0 (`highest` its value).
+pub(super) fn record(ini: &mut Ini, index: u32, name: &str, highest: u32, sub0: &str) {
+    ini.section(format!("{index:04X}"))
+        .key("SubNumber", highest + 1)
+        .key("ParameterName", name)
+        .key("ObjectType", "0x09");
+    sub(
+        ini,
+        index,
+        0,
+        sub0,
+        0x0005,
+        "const",
+        Some(highest.to_string()),
+    );
+}
+
+pub(super) fn sub<'a>(
+    ini: &'a mut Ini,
+    index: u32,
+    sub: u32,
+    name: &str,
+    data_type: u32,
+    access: &str,
+    default: Option<String>,
+) -> &'a mut Ini {
+    ini.section(format!("{index:04X}sub{sub:X}"));
+    entry_keys(ini, name, data_type, access, default)
+}
+
+/// A compact ARRAY of `len` entries.
+pub(super) fn array(
+    ini: &mut Ini,
+    index: u32,
+    name: &str,
+    data_type: u32,
+    access: &str,
+    len: usize,
+) {
+    ini.section(format!("{index:04X}"))
+        .key("ParameterName", name)
+        .key("ObjectType", "0x08")
+        .key("DataType", hex(data_type, 4))
+        .key("AccessType", access)
+        .key("CompactSubObj", len);
+}
+
+/// The `[xxxxValue]` section of a compact array.
+pub(super) fn values(ini: &mut Ini, index: u32, entries: Vec<(String, String)>) {
+    ini.section(format!("{index:04X}Value"))
+        .key("NrOfEntries", entries.len());
+    for (key, value) in entries {
+        ini.key(key, value);
+    }
+}

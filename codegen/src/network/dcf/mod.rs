@@ -7,6 +7,7 @@
 pub mod concise;
 mod ini;
 mod master;
+mod pdos;
 
 use std::fmt;
 
