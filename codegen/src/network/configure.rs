@@ -453,7 +453,7 @@ fn configure_master(
 }
 
 /// `dir` and `file` joined with `/` as dcfgen joins them (`os.path.join`).
-fn join(dir: &str, file: &str) -> String {
+pub(crate) fn join(dir: &str, file: &str) -> String {
     if dir.is_empty() || dir.ends_with('/') {
         format!("{dir}{file}")
     } else {

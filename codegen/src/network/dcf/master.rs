@@ -7,6 +7,7 @@
 //! map, and with `remote_pdo` the remote PDO mappings (0x5800–0x5FFF).
 
 use crate::network::config::{Configured, Node};
+use crate::network::configure::join;
 use crate::network::model::{Bus, SlaveSection};
 
 use super::ini::{HIGHEST, Ini, array, files_array, hex, record, sub, values, var};
@@ -30,7 +31,12 @@ pub(super) fn master_dcf(
     let uploads: Vec<(u8, &str)> = slaves(bus, configured)
         .filter(|(node, _)| !node.configuration_file.is_empty())
         .map(|(node, slave)| {
-            if let Some(file) = &slave.configuration_file {
+            // dcfgen names its own file whatever the key says.
+            let dcfgen_file = (!node.concise.is_empty())
+                .then(|| join(&node.dcf_path, &format!("{}.bin", node.name)));
+            if let Some(file) = &slave.configuration_file
+                && dcfgen_file.as_deref() != Some(file.value.as_str())
+            {
                 differences.push(Difference::ConfigurationFile {
                     node: node.name.clone(),
                     node_id: node.node_id,

@@ -373,3 +373,19 @@ fn heartbeat_product_truncates_like_python() {
     assert_eq!(heartbeat_product(100, -1.0), 0);
     assert_eq!(heartbeat_product(100, f64::NAN), 0);
 }
+
+#[test]
+fn a_product_code_without_0x1018_2_is_neither_listed_nor_counted() {
+    let (mut bus, configured) = bus();
+    let identity = bus.slaves[0].device.objects.get_mut(&0x1018).unwrap();
+    identity.entries.remove(&2);
+    let written = files(&bus, &configured, false);
+    let dcf = parse(std::str::from_utf8(&written.files.last().unwrap().bytes).unwrap());
+    assert_eq!(dcf["1F86Value"]["NrOfEntries"], "1");
+    assert!(!dcf["1F86Value"].contains_key("3"));
+    assert_eq!(dcf["1F86Value"]["4"], "0x00000099");
+    assert_eq!(
+        written.differences,
+        [Difference::UnlistedProductCode { node: "a".into() }]
+    );
+}
