@@ -1,10 +1,11 @@
 """Writes a bus file as ros2_canopen hands it to lely's dcfgen.
 
 dcfgen does not know ros2_canopen's `defaults:`/`nodes:`: before calling it,
-ros2_canopen turns every entry of `nodes:` into a slave section with the
-keys of `defaults:` put over the node's own (a dict update, so the defaults
-win) and dumps the file with its keys sorted (so the slaves, which number
-the master's PDOs, come in name order). A file without `nodes:` is dcfgen's
+ros2_canopen writes a new file of `options:`, `master:` and one slave section
+per entry of `nodes:`, with the keys of `defaults:` put over the node's own
+(the defaults win); a flat slave section beside `nodes:` is not carried
+over. The file is dumped with its keys sorted, so the slaves (which number
+the master's PDOs) come in name order. A file without `nodes:` is dcfgen's
 own format and is written as read.
 
 usage: expand_bus.py BUS_YML OUT_YML
@@ -19,13 +20,13 @@ import yaml
 def expand(cfg):
     if "nodes" not in cfg:
         return cfg, False
-    defaults = cfg.pop("defaults", None) or {}
-    nodes = cfg.pop("nodes") or {}
-    for name, node in nodes.items():
+    defaults = cfg.get("defaults") or {}
+    expanded = {"options": cfg.get("options") or {}, "master": cfg.get("master") or {}}
+    for name, node in (cfg["nodes"] or {}).items():
         slave = dict(node or {})
         slave.update(defaults)
-        cfg[name] = slave
-    return cfg, True
+        expanded[name] = slave
+    return expanded, True
 
 
 def main():
