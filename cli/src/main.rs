@@ -542,7 +542,7 @@ fn failed(path: &std::path::Path, mut diagnostics: Diagnostics, what: &str) -> E
 /// (`| head`: a broken pipe) is not an error of ours: the rest is dropped
 /// quietly. Any other failure (`> /dev/full`: no space) is printed, with
 /// exit status 1 as `Err`.
-fn print(text: &str) -> Result<(), ExitCode> {
+pub(crate) fn print(text: &str) -> Result<(), ExitCode> {
     let mut out = std::io::stdout().lock();
     match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
         Ok(()) => Ok(()),

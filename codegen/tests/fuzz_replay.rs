@@ -56,3 +56,8 @@ fn eds_reader_corpus() {
 fn yaml_reader_corpus() {
     replay("yaml_reader", fuzz_checks::yaml_reader);
 }
+
+#[test]
+fn bus_reader_corpus() {
+    replay("bus_reader", fuzz_checks::bus_reader);
+}

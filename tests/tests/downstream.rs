@@ -10,7 +10,10 @@
 //! - downstream/api-lock: the listing of a generated API locked with insta;
 //! - downstream/firmware-update: a CiA 302-3 program update, a 1 MiB image
 //!   streamed by block download to the corpus bootloader slave, simulated
-//!   (not run without ../shared: it reads the DCF).
+//!   (not run without ../shared: it reads the DCF);
+//! - downstream/machine: the three seed devices as one machine, the typed
+//!   network of eds/machine/bus.yml generated in its build script, its
+//!   process image run on the virtual bus.
 
 use std::path::Path;
 use std::process::Command;
@@ -174,4 +177,18 @@ fn api_lock_matches_its_committed_snapshot() {
         .filter(|p| p.extension().is_some_and(|x| x == "new"))
         .collect();
     assert!(pending.is_empty(), "{pending:?}");
+}
+
+/// The typed network of the seed machine builds (strict: the bus file gives
+/// no warning) and its process image works on the virtual bus.
+#[test]
+fn machine_generates_its_network_and_runs_its_process_image() {
+    let dir = workspace_root().join("downstream/machine");
+    assert!(dir.join("Cargo.lock").is_file(), "a lock file of its own");
+    let output = cargo("machine", &["test"]);
+    assert!(
+        output.contains("one_sync_cycle_on_the_virtual_bus ... ok"),
+        "{output}"
+    );
+    assert!(!output.contains("test result: FAILED"), "{output}");
 }

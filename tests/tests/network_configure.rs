@@ -220,3 +220,26 @@ fn prbt_pilz6_concise_dcf_equals_dcfgens() {
         &dir.join("dcfgen-out"),
     );
 }
+
+/// The corpus networks read from their files (`bus.yml` with
+/// `defaults:`/`nodes:`, and the expanded file dcfgen read) and configured:
+/// the concise DCFs equal dcfgen's.
+#[test]
+fn corpus_read_from_bus_files_equals_dcfgens() {
+    let Some(shared) = eds2rust_tests::shared_dir() else {
+        eds2rust_tests::not_run("network_configure (read): ../shared/network-corpus");
+        return;
+    };
+    for network in ["trinamic_pd42", "prbt_pilz6"] {
+        let dir = shared.join("network-corpus").join(network);
+        for file in ["bus.yml", "bus.expanded.yml"] {
+            let loaded = eds2rust::network::read_file(&dir.join(file), &Options::lenient());
+            assert!(
+                !loaded.diagnostics.has_errors(),
+                "{network}/{file}: {}",
+                loaded.diagnostics.render()
+            );
+            compare(&loaded.bus.expect("a bus"), &dir.join("dcfgen-out"));
+        }
+    }
+}

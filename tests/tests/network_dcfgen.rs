@@ -264,6 +264,8 @@ fn networks(shared: &Path) -> Vec<Network> {
     let mut names: Vec<String> = std::fs::read_dir(&own)
         .unwrap_or_else(|e| panic!("{}: {e}", own.display()))
         .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        // A network is a folder with a bus.yml (check/ holds fixtures).
+        .filter(|name| own.join(name).join("bus.yml").is_file())
         .collect();
     names.sort();
     for name in names {

@@ -1,9 +1,15 @@
-//! `eds2rust net check BUS`.
+//! `eds2rust net check BUS`: reads the bus file and its device files,
+//! configures the network as dcfgen does and checks it as a whole
+//! (`eds2rust::network::check`); prints the diagnostics with their source
+//! lines, the bus load estimate and a summary line. Exit status as `check`:
+//! 0 without errors, 1 with, 2 on usage errors.
 
+use std::io::Write;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::Args;
+use eds2rust::network::check::{CheckLimits, DEFAULT_MAX_BUS_LOAD_PERCENT, bus_load, check};
 
 use crate::ReadArgs;
 
@@ -11,11 +17,63 @@ use crate::ReadArgs;
 pub(crate) struct CheckArgs {
     #[command(flatten)]
     read: ReadArgs,
+    /// The highest estimated bus load, in percent of the bit rate, that is
+    /// not a warning (`net::bus-load`).
+    #[arg(long, value_name = "PERCENT", default_value_t = DEFAULT_MAX_BUS_LOAD_PERCENT)]
+    max_bus_load: f64,
     /// The bus file (bus.yml).
     bus: PathBuf,
 }
 
 pub(crate) fn run(args: CheckArgs) -> ExitCode {
-    let _ = (args.read.options(), args.bus);
-    todo!("net-check helper")
+    let options = match args.read.options() {
+        Ok(options) => options,
+        Err(message) => return usage(&message),
+    };
+    if !(args.max_bus_load.is_finite() && args.max_bus_load >= 0.0) {
+        return usage(&format!(
+            "--max-bus-load {} is not a percentage (0 or more)",
+            args.max_bus_load
+        ));
+    }
+    let limits = CheckLimits {
+        max_bus_load_percent: args.max_bus_load,
+    };
+    let loaded = eds2rust::network::read_file(&args.bus, &options);
+    let mut diagnostics = loaded.diagnostics;
+    let mut load = None;
+    let mut nodes = 0;
+    if let Some(bus) = &loaded.bus {
+        let (configured, mut found) = eds2rust::network::configure(bus);
+        found.extend(check(bus, &configured, &limits));
+        found.apply_levels(&options.levels, options.strict);
+        diagnostics.extend(found);
+        load = Some(bus_load(bus, &configured));
+        nodes = configured.nodes.len();
+    }
+    diagnostics.span_lines();
+    let mut text = diagnostics.render();
+    if let Some(load) = load {
+        text.push_str(&load.to_string());
+    }
+    text.push_str(&format!(
+        "{}: {} nodes, {} errors, {} warnings\n",
+        eds2rust::text::terminal_line(&args.bus.display().to_string()),
+        nodes,
+        diagnostics.error_count(),
+        diagnostics.warning_count()
+    ));
+    if let Err(code) = crate::print(&text) {
+        return code;
+    }
+    if diagnostics.has_errors() {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    }
+}
+
+fn usage(message: &str) -> ExitCode {
+    let _ = writeln!(std::io::stderr().lock(), "error: {message}");
+    ExitCode::from(2)
 }

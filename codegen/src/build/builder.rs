@@ -6,12 +6,16 @@ use std::path::{Path, PathBuf};
 
 use super::cargo::{cargo_lines, in_build_script, project_dir};
 use super::files::write_if_changed;
+use super::network::generate_network;
 use super::{Error, error, generate_device_reading, push_unique};
 use crate::diag::{Diagnostics, Levels};
 use crate::r#gen::rust::Options;
 
 /// Generates the Rust of CANopen devices from a build script: one
-/// `<OUT_DIR>/<name>.rs` per [`device`](Builder::device), for `include!`.
+/// `<OUT_DIR>/<name>.rs` per [`device`](Builder::device), for `include!`;
+/// and per [`network`](Builder::network) one `<OUT_DIR>/<name>.rs` with a
+/// module per node and the `network` module (its node files beside it in
+/// `<OUT_DIR>/<name>/`).
 ///
 /// Every problem is reported when [`generate`](Builder::generate) (or
 /// [`build`](Builder::build)) runs, never by a panic: all diagnostics of all
@@ -19,6 +23,7 @@ use crate::r#gen::rust::Options;
 #[derive(Debug, Clone, Default)]
 pub struct Builder {
     devices: Vec<DeviceInput>,
+    networks: Vec<NetworkInput>,
     /// Overlays given before any device.
     orphan_overlays: Vec<PathBuf>,
     runtime_path: Option<String>,
@@ -28,6 +33,12 @@ pub struct Builder {
     cargo_output: Option<bool>,
     max_input_size: Option<u64>,
     allow_base_dirs: Vec<PathBuf>,
+}
+
+#[derive(Debug, Clone)]
+struct NetworkInput {
+    name: String,
+    bus_file: PathBuf,
 }
 
 #[derive(Debug, Clone)]
@@ -87,6 +98,24 @@ impl Builder {
             name: name.to_string(),
             input: input.as_ref().to_path_buf(),
             overlays: Vec::new(),
+        });
+        self
+    }
+
+    /// Adds a network read from the bus file `bus_file` (lely dcfgen's
+    /// YAML, as ros2_canopen users write it; device files relative to it),
+    /// generated into `<out_dir>/<name>.rs` (and its nodes' files in
+    /// `<out_dir>/<name>/`): a module per node, named after its key in the
+    /// bus file, with the node's object dictionary as [`device`] makes it
+    /// and in `pdo` the PDOs the network configures, COB-IDs resolved; and
+    /// the `network` module (nodes, the master's process image, timing).
+    /// `name` follows the rules of a device name and is unique among both.
+    ///
+    /// [`device`]: Builder::device
+    pub fn network(&mut self, name: &str, bus_file: impl AsRef<Path>) -> &mut Self {
+        self.networks.push(NetworkInput {
+            name: name.to_string(),
+            bus_file: bus_file.as_ref().to_path_buf(),
         });
         self
     }
@@ -248,7 +277,7 @@ impl Builder {
         let mut names = HashSet::new();
         let mut outputs = Vec::new();
         for device in &self.devices {
-            if let Err(message) = check_name(&device.name) {
+            if let Err(message) = check_name("device", &device.name) {
                 all.push(error("build::device-name", &device.input, message));
             } else if !names.insert(device.name.as_str()) {
                 all.push(error(
@@ -264,7 +293,28 @@ impl Builder {
                 Ok(output) => {
                     report.warnings.extend(output.warnings.clone());
                     all.extend(output.warnings);
-                    outputs.push((device.name.as_str(), output.code));
+                    outputs.push((PathBuf::from(format!("{}.rs", device.name)), output.code));
+                }
+                Err(diagnostics) => all.extend(diagnostics),
+            }
+        }
+        for network in &self.networks {
+            if let Err(message) = check_name("network", &network.name) {
+                all.push(error("build::device-name", &network.bus_file, message));
+            } else if !names.insert(network.name.as_str()) {
+                all.push(error(
+                    "build::device-name",
+                    &network.bus_file,
+                    format!("name `{}` is given twice", network.name),
+                ));
+            }
+            let generated = generate_network(&network.name, &network.bus_file, &options, &read);
+            push_unique(&mut report.files_read, generated.files);
+            match generated.result {
+                Ok((files, warnings)) => {
+                    report.warnings.extend(warnings.clone());
+                    all.extend(warnings);
+                    outputs.extend(files);
                 }
                 Err(diagnostics) => all.extend(diagnostics),
             }
@@ -285,8 +335,8 @@ impl Builder {
                 )),
             }
         }
-        for (name, code) in outputs {
-            let path = out_dir.join(format!("{name}.rs"));
+        for (file, code) in outputs {
+            let path = out_dir.join(file);
             match write_if_changed(&path, code.as_bytes()) {
                 Ok(true) => report.written.push(path),
                 Ok(false) => report.unchanged.push(path),
@@ -314,8 +364,9 @@ const KEYWORDS: &[&str] = &[
     "union", "unsafe", "unsized", "use", "virtual", "where", "while", "yield",
 ];
 
-/// `Ok` when `name` is a snake_case Rust identifier.
-fn check_name(name: &str) -> Result<(), String> {
+/// `Ok` when `name` is a snake_case Rust identifier; `what` names it in
+/// messages ("device", "network").
+fn check_name(what: &str, name: &str) -> Result<(), String> {
     let shape = name
         .bytes()
         .all(|b| b.is_ascii_lowercase() || b.is_ascii_digit() || b == b'_')
@@ -323,14 +374,14 @@ fn check_name(name: &str) -> Result<(), String> {
         && name.bytes().any(|b| b != b'_');
     if !shape {
         return Err(format!(
-            "device name `{}` is not a snake_case Rust identifier \
+            "{what} name `{}` is not a snake_case Rust identifier \
              (lower-case ASCII letters, digits and `_`, not starting with a digit)",
             name.escape_debug()
         ));
     }
     if KEYWORDS.contains(&name) {
         return Err(format!(
-            "device name `{name}` is a Rust keyword; it names a module"
+            "{what} name `{name}` is a Rust keyword; it names a module"
         ));
     }
     Ok(())
@@ -343,12 +394,12 @@ mod tests {
     #[test]
     fn names() {
         for ok in ["drive", "linak_techline", "_x", "a1", "a__b"] {
-            assert_eq!(check_name(ok), Ok(()), "{ok}");
+            assert_eq!(check_name("device", ok), Ok(()), "{ok}");
         }
         for bad in [
             "", "_", "__", "Drive", "my-drive", "1x", "type", "gen", "a b", "é",
         ] {
-            assert!(check_name(bad).is_err(), "{bad}");
+            assert!(check_name("device", bad).is_err(), "{bad}");
         }
     }
 }

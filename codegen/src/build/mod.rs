@@ -34,6 +34,7 @@ mod builder;
 mod cargo;
 mod error;
 mod files;
+mod network;
 
 use std::path::{Path, PathBuf};
 
@@ -47,6 +48,7 @@ pub use builder::{Builder, Report, WARNINGS_FILE};
 pub use cargo::{cargo_lines, error_lines, in_build_script, project_dir};
 pub use error::Error;
 pub use files::write_whole;
+pub use network::{GeneratedNetwork, generate_bus, generate_network};
 
 /// What generating one device produced.
 #[derive(Debug, Clone)]

@@ -207,6 +207,25 @@ impl Diagnostics {
             .sort_by(|a, b| (&a.file, a.location.line).cmp(&(&b.file, b.location.line)));
     }
 
+    /// Gives every diagnostic that has a line but no span the span of its
+    /// whole line, where its file's text is registered
+    /// ([`add_source`](Self::add_source)), so that rendering shows the line.
+    pub fn span_lines(&mut self) {
+        self.flush_caps();
+        for d in &mut self.items {
+            if d.location.span.is_some() {
+                continue;
+            }
+            let (Some(line), Some((_, text))) = (
+                d.location.line,
+                self.sources.iter().find(|(name, _)| *name == d.file),
+            ) else {
+                continue;
+            };
+            d.location.span = Some(line_span(text, line));
+        }
+    }
+
     /// Renders every diagnostic with its source line, without colours.
     pub fn render(&self) -> String {
         self.render_where(|_| true)
@@ -272,6 +291,25 @@ impl Diagnostics {
         }
         out
     }
+}
+
+/// The byte range of 1-based line `line` of `text` (without its line
+/// end), to underline a whole line; an empty range at the end past the
+/// last line.
+pub fn line_span(text: &str, line: u32) -> Range<usize> {
+    // Line n starts after the (n-1)th newline.
+    let newlines = usize::try_from(line)
+        .unwrap_or(usize::MAX)
+        .saturating_sub(1);
+    let start = match newlines.checked_sub(1) {
+        None => 0,
+        Some(k) => text
+            .match_indices('\n')
+            .nth(k)
+            .map_or(text.len(), |(i, _)| i + 1),
+    };
+    let end = text[start..].find('\n').map_or(text.len(), |n| start + n);
+    start..end
 }
 
 /// Terminal-safe text: [`crate::text::terminal`] (escape sequences and

@@ -164,12 +164,53 @@ pub const RULES: &[Rule] = &[
         "a PDO with cob_id: auto when no 11-bit COB-ID is left (0x680–0x6DF used up)",
     ),
     rule(
+        "net::bad-value",
+        "a bus file value of the wrong type or outside its key's range",
+    ),
+    rule(
+        "net::bus-load",
+        "an estimated bus load above the limit (--max-bus-load)",
+    ),
+    rule("net::cob-id-collision", "two nodes sending on one COB-ID"),
+    rule(
+        "net::cob-id-restricted",
+        "a PDO COB-ID in a range CiA 301 restricts",
+    ),
+    rule(
+        "net::device-file",
+        "a slave's device file that cannot be read",
+    ),
+    rule(
+        "net::dropped-section",
+        "a slave section beside `nodes:`, which ros2_canopen's expansion drops",
+    ),
+    rule(
+        "net::duplicate-key",
+        "a key given twice in one map of a bus file (the later wins)",
+    ),
+    rule(
+        "net::duplicate-node",
+        "a slave name given twice in a bus file",
+    ),
+    rule(
         "net::heartbeat-and-guarding",
         "a node with both a heartbeat producer time and node guarding",
     ),
     rule(
+        "net::heartbeat-no-producer",
+        "a heartbeat consumer of a node that sends none",
+    ),
+    rule(
+        "net::heartbeat-timing",
+        "a heartbeat consumer time not above its producer time",
+    ),
+    rule(
         "net::identity-differs",
         "a bus file's revision or serial number that differs from the device file's",
+    ),
+    rule(
+        "net::missing-key",
+        "a key dcfgen needs (`master:`, a slave's `dcf`, an item's `index`)",
     ),
     rule(
         "net::missing-object",
@@ -183,14 +224,63 @@ pub const RULES: &[Rule] = &[
         "net::no-such-pdo",
         "an rpdo/tpdo number the device file has no PDO for",
     ),
+    rule("net::node-id", "a node id outside 1..=127 in a bus file"),
+    rule("net::node-id-collision", "two nodes with one node id"),
     rule(
         "net::not-writable",
         "a configuration write to an entry that is not writable",
     ),
     rule(
+        "net::pdo-direction",
+        "a bus file's PDO mapping against the entry's access",
+    ),
+    rule(
+        "net::pdo-mapping",
+        "a bus file's PDO mapping of an object that is not PDO-mappable",
+    ),
+    rule(
+        "net::pdo-not-generated",
+        "a PDO a network configures that gets no generated struct",
+    ),
+    rule(
+        "net::pdo-number",
+        "a PDO number outside 1..=512 in a bus file",
+    ),
+    rule(
+        "net::pdo-too-long",
+        "a bus file's PDO mapping of more than 64 bits",
+    ),
+    rule("net::pdo-unconsumed", "a PDO sent that no node reads"),
+    rule("net::pdo-unproduced", "a PDO awaited that is never sent"),
+    rule(
+        "net::sdo-pdo-conflict",
+        "an `sdo:` write to a PDO parameter that the PDO sections set or do not see",
+    ),
+    rule(
+        "net::syntax",
+        "bus file YAML syntax, not UTF-8, over a limit, or not a map",
+    ),
+    rule(
+        "net::too-large",
+        "more than 127 slaves, or `defaults:` expanded beyond the limit",
+    ),
+    rule(
+        "net::truncated",
+        "a fraction where dcfgen needs an integer (it cuts it)",
+    ),
+    rule(
+        "net::truthy-text",
+        "text where dcfgen reads a boolean (any non-empty text is true)",
+    ),
+    rule(
+        "net::unknown-key",
+        "an unknown key in a PDO, mapping or sdo item (dcfgen ignores it)",
+    ),
+    rule(
         "net::unknown-object",
         "a write or mapping of an object or sub-object the device file lacks",
     ),
+    rule("net::unused-defaults", "`defaults:` without `nodes:`"),
     rule(
         "net::value-range",
         "a configuration value that does not fit its entry's data type",

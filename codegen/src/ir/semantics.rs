@@ -4,7 +4,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use super::{Identity, Literal, Origin};
+use super::{Access, Identity, Literal, Origin};
 
 /// Meaning of one entry's raw value.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
@@ -218,6 +218,16 @@ impl PdoDirection {
     /// The mapping parameter index of PDO number `n` (1-based).
     pub fn mapping_index(self, n: u16) -> u16 {
         self.communication_index(n) + 0x200
+    }
+
+    /// Whether a PDO of this direction may map an entry of `access`: an
+    /// RPDO writes its entries (they must be writable), a TPDO reads them
+    /// (they must be readable).
+    pub fn allows(self, access: Access) -> bool {
+        match self {
+            PdoDirection::Rpdo => access.is_writable(),
+            PdoDirection::Tpdo => access.is_readable(),
+        }
     }
 }
 

@@ -24,7 +24,7 @@ pub struct Configured {
 pub struct Node {
     /// The slave's name (its YAML key).
     pub name: String,
-    /// Position of its section in [`Bus::slaves`].
+    /// Position of its section in [`Bus::slaves`](super::model::Bus::slaves).
     pub slave: usize,
     pub node_id: u8,
     /// The PDOs the node receives (its RPDOs), valid and mapped ones only,

@@ -44,9 +44,11 @@ pub struct Bus {
     pub options: BusOptions,
     /// `master:`.
     pub master: MasterSection,
-    /// The slaves in dcfgen's order: file order of the flat sections, then
-    /// the expanded `nodes:` ordered by name (ros2_canopen's expansion).
-    /// That order numbers the master's PDOs.
+    /// The slaves in dcfgen's order: file order, or, in a file with
+    /// `nodes:` (which only ros2_canopen reads: it expands the nodes, drops
+    /// other slave sections and writes the file with its keys sorted before
+    /// dcfgen reads it), the nodes ordered by name. That order numbers the
+    /// master's PDOs.
     pub slaves: Vec<SlaveSection>,
     /// Keys dcfgen does not use (ros2_canopen's `driver`, `package`,
     /// `period`, ...), kept in file order. Listed at info level, never an
@@ -217,6 +219,18 @@ pub struct SlaveSection {
     pub restore_configuration: Option<At<u8>>,
     /// `sdo`: writes at boot, in file order.
     pub sdo: Vec<SdoItem>,
+}
+
+impl SlaveSection {
+    /// The node id dcfgen gives the slave: its `node_id` key, else the
+    /// device file's `[DeviceComissioning]` NodeID (a DCF's); `None` when
+    /// neither says (dcfgen then ignores the slave).
+    pub fn effective_node_id(&self) -> Option<u8> {
+        self.node_id
+            .as_ref()
+            .map(|n| n.value)
+            .or_else(|| self.device.commissioning.as_ref()?.node_id)
+    }
 }
 
 /// One `rpdo`/`tpdo` entry.

@@ -13,7 +13,7 @@ mod lower;
 mod meaning;
 mod pdo;
 pub mod schema;
-mod yaml_error;
+pub(crate) mod yaml_error;
 
 use std::path::Path;
 
@@ -137,7 +137,8 @@ fn read_table(file: &str, bytes: &[u8], base: Base) -> Loaded {
         }
         Err(err) => {
             let at = err.location().map(|l| At::from_location(&l));
-            let message = yaml_error::message(&err).unwrap_or_else(|| first_line(&err.to_string()));
+            let message = yaml_error::message(&err, &yaml_error::TABLE)
+                .unwrap_or_else(|| first_line(&err.to_string()));
             let mut notes = Vec::new();
             if let Some(suggestion) = levels::did_you_mean(&message) {
                 notes.push(suggestion);
@@ -169,7 +170,7 @@ fn read_table(file: &str, bytes: &[u8], base: Base) -> Loaded {
 
 /// serde-saphyr's message without its `line L column C:` prefix and without
 /// the source excerpt it appends (the renderer shows the source itself).
-fn first_line(message: &str) -> String {
+pub(crate) fn first_line(message: &str) -> String {
     let line = message.lines().next().unwrap_or("").trim();
     let line = line.strip_prefix("error: ").unwrap_or(line);
     let line = match line.find(": ") {
@@ -203,7 +204,7 @@ impl At {
         At::from_location(&spanned.referenced)
     }
 
-    fn from_location(location: &serde_saphyr::Location) -> At {
+    pub(crate) fn from_location(location: &serde_saphyr::Location) -> At {
         let span = location.span();
         let line = u32::try_from(location.line()).unwrap_or(0);
         match span.byte_offset().and_then(|o| usize::try_from(o).ok()) {
@@ -221,21 +222,9 @@ impl At {
     }
 
     /// The byte range to underline: the scalar, or the rest of its line.
-    fn span(self, text: &str) -> std::ops::Range<usize> {
+    pub(crate) fn span(self, text: &str) -> std::ops::Range<usize> {
         if self.offset == usize::MAX {
-            // Line n starts after the (n-1)th newline.
-            let newlines = usize::try_from(self.line)
-                .unwrap_or(usize::MAX)
-                .saturating_sub(1);
-            let start = match newlines.checked_sub(1) {
-                None => 0,
-                Some(k) => text
-                    .match_indices('\n')
-                    .nth(k)
-                    .map_or(text.len(), |(i, _)| i + 1),
-            };
-            let end = text[start..].find('\n').map_or(text.len(), |n| start + n);
-            return start..end;
+            return crate::diag::line_span(text, self.line);
         }
         let start = self.offset.min(text.len());
         if !text.is_char_boundary(start) {

@@ -421,11 +421,7 @@ fn map_item(
                     problem.to_string(),
                 );
             }
-            let wrong_way = match direction {
-                PdoDirection::Rpdo => !entry.access.is_writable(),
-                PdoDirection::Tpdo => !entry.access.is_readable(),
-            };
-            if wrong_way {
+            if !direction.allows(entry.access) {
                 let (verb, way) = match direction {
                     PdoDirection::Rpdo => ("writes", "writable"),
                     PdoDirection::Tpdo => ("reads", "readable"),

@@ -2,7 +2,8 @@
 //! them as a device (EDS/DCF or YAML object table) and, when the reading has
 //! no error, runs the rest of what a build script does with the device: the
 //! Rust generator (which formats its output with prettyplease), the rendered
-//! diagnostics and the `cargo:` lines. They panic only when a property is
+//! diagnostics and the `cargo:` lines; or reads them as a bus file
+//! ([`bus_reader`]). They panic only when a property is
 //! broken. The cargo-fuzz targets in codegen/fuzz run them coverage-guided;
 //! tests/fuzz_replay.rs replays the committed corpora through them in CI.
 #![allow(dead_code)]
@@ -17,6 +18,7 @@ use eds2rust::read::{Loaded, Options};
 /// The name the input has in diagnostics.
 const EDS_NAME: &str = "fuzz.eds";
 const YAML_NAME: &str = "fuzz.yaml";
+const BUS_NAME: &str = "fuzz_bus.yml";
 
 /// Where a table's `base:` is resolved: the malformed-YAML fixtures, which
 /// hold a small valid EDS (`base_ok.eds`) for overlays to apply on. The
@@ -62,6 +64,56 @@ pub fn yaml_reader(data: &[u8]) {
     check_confined(&loaded);
     build(&loaded);
     hostile_base(data);
+}
+
+/// The bus file reader on raw bytes, device files resolved in
+/// [`base_dir`] (where `base_ok.eds` is): it returns, a bus unless an
+/// error says why not, every error of the bus file past its syntax names
+/// a line, the model keeps to the ranges the reader promises, and the
+/// diagnostics render without terminal hazards or the environment.
+pub fn bus_reader(data: &[u8]) {
+    let loaded = eds2rust::network::read_bytes(BUS_NAME, data, base_dir(), &options());
+    let rendered = loaded.diagnostics.render();
+    assert!(
+        !rendered.chars().any(is_terminal_hazard),
+        "the diagnostics render a control or bidi character: {rendered:?}"
+    );
+    check_no_environment(&rendered, data);
+    for line in error_lines(&loaded.diagnostics) {
+        assert!(
+            !line.contains('\n'),
+            "a cargo line with a line break: {line:?}"
+        );
+    }
+    for d in loaded.diagnostics.iter() {
+        if d.file == BUS_NAME && d.code != "net::syntax" {
+            assert!(d.location.line.is_some(), "no line: {d}");
+        }
+    }
+    let Some(bus) = &loaded.bus else {
+        assert!(loaded.diagnostics.has_errors(), "no bus and no error");
+        return;
+    };
+    assert!(bus.slaves.len() <= 127, "{} slaves", bus.slaves.len());
+    let mut names = std::collections::BTreeSet::new();
+    for slave in &bus.slaves {
+        assert!(names.insert(&slave.name), "slave {} twice", slave.name);
+        if let Some(id) = &slave.node_id {
+            assert!((1..=127).contains(&id.value), "node id {}", id.value);
+        }
+        for number in slave.rpdo.keys().chain(slave.tpdo.keys()) {
+            assert!((1..=512).contains(number), "PDO {number}");
+        }
+    }
+    // The configuration and the whole-bus check return on any bus, and
+    // each check diagnostic names the bus file.
+    let (configured, _) = eds2rust::network::configure(bus);
+    let limits = eds2rust::network::check::CheckLimits::default();
+    let checked = eds2rust::network::check::check(bus, &configured, &limits);
+    for d in checked.iter() {
+        assert_eq!(d.file, BUS_NAME, "{d}");
+    }
+    let _ = eds2rust::network::check::bus_load(bus, &configured).to_string();
 }
 
 /// Paths an attacker would name in `base:`; each fuzz input is tried as a
@@ -114,12 +166,20 @@ fn check_confined(loaded: &Loaded) {
             );
         }
     }
-    let rendered = loaded.diagnostics.render();
+    check_no_environment(&loaded.diagnostics.render(), b"");
+}
+
+/// No rendered diagnostic quotes a variable of the environment (what
+/// `/proc/self/environ` holds) that the input itself does not hold (the
+/// fuzzer learns the values this check compares with and writes them into
+/// its inputs, which diagnostics may quote).
+fn check_no_environment(rendered: &str, input: &[u8]) {
+    let input = String::from_utf8_lossy(input);
     for (key, value) in std::env::vars() {
         if value.len() >= 8 {
             let pair = format!("{key}={value}");
             assert!(
-                !rendered.contains(&pair),
+                !rendered.contains(&pair) || input.contains(&pair),
                 "the environment is quoted ({key})"
             );
         }

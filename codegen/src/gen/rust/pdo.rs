@@ -1,7 +1,10 @@
 //! The `pdo` module: one struct per default PDO mapping, with `encode` into a
 //! fixed array and `decode` from a slice by shifts and masks at the offsets
 //! the mapping gives (any bit offset, widths 1–64, sign extension), COB-ID
-//! helpers per node id, and the runtime's `Pdo` trait.
+//! helpers per node id, and the runtime's `Pdo` trait. The same code makes
+//! the PDOs a network configures ([`Source::Network`]): the network's
+//! mapping and communication values stand in the device's entries as
+//! configured values, as in a DCF.
 
 use std::collections::BTreeMap;
 
@@ -97,20 +100,53 @@ pub(crate) fn plan<'a>(
         .collect()
 }
 
-/// The `pdo` module's items (empty when the device has no default PDO).
+/// Where the PDOs of the `pdo` module come from.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Source {
+    /// The device file's defaults (mapping and communication defaults).
+    Defaults,
+    /// A network's configuration: the mapping and communication entries'
+    /// configured values (`parameter_value`, as a DCF holds them) first.
+    Network,
+}
+
+/// One generated PDO struct, for the code that refers to it (the network
+/// module's process image).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub(crate) struct Emitted {
+    pub(crate) direction: PdoDirection,
+    pub(crate) number: u16,
+    pub(crate) ident: String,
+    /// Data length in bytes.
+    pub(crate) len: usize,
+    /// Whether a field holds a float (no `Eq`, `Hash`).
+    pub(crate) float: bool,
+}
+
+/// The `pdo` module's items (empty when the device has no PDO of `source`)
+/// and what each struct is.
 pub(crate) fn emit(
     device: &Device,
     infos: &BTreeMap<(u16, u8), EntryInfo>,
+    source: Source,
     rt: &TokenStream,
     diags: &mut Diagnostics,
-) -> TokenStream {
+) -> (TokenStream, Vec<Emitted>) {
     let mut out = TokenStream::new();
+    let mut emitted = Vec::new();
     for p in plan(device, infos, diags) {
         out.extend(emit_struct(
-            device, &p.layout, &p.ident, p.label, &p.fields, rt,
+            device, &p.layout, &p.ident, p.label, &p.fields, source, rt,
         ));
+        emitted.push(Emitted {
+            direction: p.layout.direction,
+            number: p.layout.number,
+            ident: p.ident.to_string(),
+            len: p.layout.total.div_ceil(8) as usize,
+            float: p.layout.fields.iter().any(|f| f.raw.is_float()),
+        });
     }
-    out
+    (out, emitted)
 }
 
 fn warn(diags: &mut Diagnostics, mapping: &Object, message: String) {
@@ -296,6 +332,7 @@ fn emit_struct(
     ident: &proc_macro2::Ident,
     label: Option<&crate::ir::PdoLabel>,
     names: &super::naming::Names,
+    source: Source,
     rt: &TokenStream,
 ) -> TokenStream {
     let len = layout.total.div_ceil(8) as usize;
@@ -320,17 +357,34 @@ fn emit_struct(
     let comm = device.objects.get(&comm_index);
     let comm_default = |sub: u8| {
         comm.and_then(|o| o.entries.get(&sub))
-            .and_then(|e| e.default.as_ref())
+            .and_then(|e| match source {
+                Source::Defaults => e.default.as_ref(),
+                Source::Network => e.parameter_value.as_ref().or(e.default.as_ref()),
+            })
     };
     let mut facts = Vec::new();
+    if source == Source::Network
+        && let Some(t) = comm_default(1)
+    {
+        facts.push(format!("COB-ID {}", docs::text(&t.text)));
+    }
     if let Some(t) = comm_default(2) {
         facts.push(format!("transmission type {}", docs::text(&t.text)));
+    }
+    if source == Source::Network
+        && let Some(t) = comm_default(3).filter(|_| layout.direction == PdoDirection::Tpdo)
+    {
+        facts.push(format!("inhibit time {} × 100 µs", docs::text(&t.text)));
     }
     if let Some(t) = comm_default(5).filter(|_| layout.direction == PdoDirection::Tpdo) {
         facts.push(format!("event timer {} ms", docs::text(&t.text)));
     }
     if !facts.is_empty() {
-        doc.para(format!("Defaults: {}.", facts.join(", ")));
+        let what = match source {
+            Source::Defaults => "Defaults",
+            Source::Network => "Configured by the network",
+        };
+        doc.para(format!("{what}: {}.", facts.join(", ")));
     }
     doc.para("| Bits | Bytes | Field | Object | Type |");
     doc.line("|---|---|---|---|---|");
@@ -408,7 +462,7 @@ fn emit_struct(
     encodes.reverse();
     let derives = super::derives::attr(super::derives::PDO, float);
     let cob_default = comm_default(1);
-    let cob = cob_id_items(cob_default, rt);
+    let cob = cob_id_items(cob_default, source, rt);
     let default_cob_id = default_cob_id_fn(cob_default, rt);
     let mapping_lits = layout.entries.iter().map(|&e| prim::hex(u128::from(e)));
     let number = Literal::u16_unsuffixed(layout.number);
@@ -488,7 +542,11 @@ fn default_cob_id_fn(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> 
 /// `COB_ID`/`CAN_ID` for a fixed one, nothing without a default: the COB-ID
 /// entry as the runtime's `od::standard::PdoCobId`, the identifier on the
 /// bus as its `CanId`.
-fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> TokenStream {
+fn cob_id_items(
+    default: Option<&crate::ir::Literal>,
+    source: Source,
+    rt: &TokenStream,
+) -> TokenStream {
     let Some(literal) = default else {
         return TokenStream::new();
     };
@@ -519,13 +577,22 @@ fn cob_id_items(default: Option<&crate::ir::Literal>, rt: &TokenStream) -> Token
             }
         }
     } else {
-        let doc = format!(
-            " The default COB-ID entry value, {text} (bit 31 set means the PDO is disabled)."
-        );
+        let (doc, can_doc) = match source {
+            Source::Defaults => (
+                format!(
+                    " The default COB-ID entry value, {text} (bit 31 set means the PDO is disabled)."
+                ),
+                " The CAN identifier of the default COB-ID.",
+            ),
+            Source::Network => (
+                format!(" The COB-ID entry value the network configures, {text}."),
+                " The CAN identifier the network configures.",
+            ),
+        };
         quote! {
             #[doc = #doc]
             pub const COB_ID: #rt::od::standard::PdoCobId = #rt::od::standard::PdoCobId::from_raw(#value_lit);
-            #[doc = " The CAN identifier of the default COB-ID."]
+            #[doc = #can_doc]
             pub const CAN_ID: #rt::CanId = Self::COB_ID.can_id();
         }
     }
