@@ -91,8 +91,10 @@ enum Command {
         file: PathBuf,
     },
     /// Prints a compact listing of the generated API of one device, one
-    /// line per public item (docs/api-listing.md), for a snapshot test.
-    /// Diagnostics go to stderr; nothing is printed when there is an error.
+    /// line per public item (docs/api-listing.md), for a snapshot test; of
+    /// a bus file, the network's wiring and every node's listing
+    /// (docs/network.md). Diagnostics go to stderr; nothing is printed
+    /// when there is an error.
     Api {
         /// A YAML overlay table (without `base:`) applied on the input; may
         /// be given several times, applied in order.
@@ -100,12 +102,13 @@ enum Command {
         overlays: Vec<PathBuf>,
         #[command(flatten)]
         read: ReadArgs,
-        /// An EDS/DCF file or a YAML object table.
+        /// An EDS/DCF file, a YAML object table or a bus file.
         file: PathBuf,
     },
     /// Compares two versions of a device: every object, sub, type, access
     /// right, default, limit, name, semantic and default PDO that changed,
     /// each classified breaking, additive or compatible (docs/diff.md).
+    /// Two bus files: the wiring and each node's device (docs/network.md).
     Diff {
         /// A YAML overlay applied on OLD; may be given several times, in order.
         #[arg(long = "old-overlay", value_name = "FILE")]
@@ -124,9 +127,9 @@ enum Command {
         ignore_semantics: bool,
         #[command(flatten)]
         read: ReadArgs,
-        /// The old version: an EDS/DCF file or a YAML object table.
+        /// The old version: an EDS/DCF file, a YAML object table or a bus file.
         old: PathBuf,
-        /// The new version: an EDS/DCF file or a YAML object table.
+        /// The new version: an EDS/DCF file, a YAML object table or a bus file.
         new: PathBuf,
     },
     /// Decodes a recorded CAN trace into named, typed CANopen values
@@ -242,6 +245,19 @@ enum FailOn {
     Any,
     /// Exit 0 whatever changed.
     Never,
+}
+
+impl FailOn {
+    /// The lowest severity that fails, `None` for `never`.
+    fn threshold(self) -> Option<eds2rust::diff::Severity> {
+        use eds2rust::diff::Severity;
+        match self {
+            FailOn::Breaking => Some(Severity::Breaking),
+            FailOn::Additive => Some(Severity::Additive),
+            FailOn::Any => Some(Severity::Compatible),
+            FailOn::Never => None,
+        }
+    }
 }
 
 fn main() -> ExitCode {
@@ -378,7 +394,11 @@ fn diff(
     diff_options: &eds2rust::diff::Options,
     options: &Options,
 ) -> ExitCode {
-    use eds2rust::diff::{Severity, render};
+    use eds2rust::diff::render;
+    if eds2rust::network::is_bus_file(old) || eds2rust::network::is_bus_file(new) {
+        let sides = ((old, old_overlays), (new, new_overlays));
+        return net::review::diff(sides.0, sides.1, format, fail_on, diff_options, options);
+    }
     let old_device = diff_side(old, old_overlays, options);
     let new_device = diff_side(new, new_overlays, options);
     let (Some(old_device), Some(new_device)) = (old_device, new_device) else {
@@ -394,12 +414,7 @@ fn diff(
     if let Err(code) = print(&text) {
         return code;
     }
-    let threshold = match fail_on {
-        FailOn::Breaking => Some(Severity::Breaking),
-        FailOn::Additive => Some(Severity::Additive),
-        FailOn::Any => Some(Severity::Compatible),
-        FailOn::Never => None,
-    };
+    let threshold = fail_on.threshold();
     let fails = threshold.is_some_and(|t| changes.iter().any(|c| c.severity >= t));
     if fails {
         ExitCode::from(1)
@@ -511,6 +526,9 @@ fn generate(
 }
 
 fn api(path: &std::path::Path, overlays: &[PathBuf], options: &Options) -> ExitCode {
+    if eds2rust::network::is_bus_file(path) {
+        return net::review::api(path, overlays, options);
+    }
     match eds2rust::build::api_listing_files(path, overlays, options) {
         Ok(listing) => {
             let _ = write!(std::io::stderr().lock(), "{}", listing.warnings.render());

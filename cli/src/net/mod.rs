@@ -3,6 +3,7 @@
 
 mod check;
 mod dcf;
+pub(crate) mod review;
 
 use std::process::ExitCode;
 

@@ -27,7 +27,7 @@
 //! The rules for every kind are in `docs/diff.md`.
 
 mod entries;
-mod pdo;
+pub(crate) mod pdo;
 pub mod render;
 mod semantics;
 
@@ -262,9 +262,15 @@ pub struct Summary {
 
 impl Summary {
     pub fn of(changes: &[Change]) -> Summary {
+        Summary::of_severities(changes.iter().map(|c| c.severity))
+    }
+
+    /// Counts of these severities (for lists of other change types, such
+    /// as a network's).
+    pub fn of_severities(severities: impl IntoIterator<Item = Severity>) -> Summary {
         let mut s = Summary::default();
-        for c in changes {
-            match c.severity {
+        for severity in severities {
+            match severity {
                 Severity::Breaking => s.breaking += 1,
                 Severity::Additive => s.additive += 1,
                 Severity::Compatible => s.compatible += 1,
@@ -385,7 +391,7 @@ fn same_literal(a: &Literal, b: &Literal) -> bool {
 }
 
 /// `0x1F` for a non-negative integer, `-0x1F` for a negative one.
-fn hex(v: i128) -> String {
+pub(crate) fn hex(v: i128) -> String {
     if v < 0 {
         format!("-0x{:X}", v.unsigned_abs())
     } else {

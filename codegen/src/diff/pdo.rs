@@ -45,7 +45,7 @@ fn active(device: &Device, index: u16) -> Option<Vec<u32>> {
     )
 }
 
-fn describe(raw: u32) -> String {
+pub(crate) fn describe(raw: u32) -> String {
     let m = MappedObject::from_raw(raw);
     if m.is_dummy() {
         format!("dummy 0x{:04X} ({} bits)", m.index, m.bits)
@@ -54,7 +54,7 @@ fn describe(raw: u32) -> String {
     }
 }
 
-fn listed(mapping: &[u32]) -> Vec<String> {
+pub(crate) fn listed(mapping: &[u32]) -> Vec<String> {
     mapping.iter().map(|&raw| describe(raw)).collect()
 }
 

@@ -8,7 +8,7 @@ use super::{Change, Summary, Val};
 use crate::text::{code_span, terminal_line};
 
 /// Where a change is: `0x6041 sub 0`, `0x1A00`, or `device` for index 0.
-fn place(c: &Change) -> String {
+pub(crate) fn place(c: &Change) -> String {
     match (c.index, c.subindex) {
         (0, None) => "device".into(),
         (i, None) => format!("0x{i:04X}"),
@@ -18,8 +18,11 @@ fn place(c: &Change) -> String {
 
 /// `3 changes: 1 breaking, 1 additive, 1 compatible`.
 pub fn summary(changes: &[Change]) -> String {
-    let s = Summary::of(changes);
-    let total = changes.len();
+    summary_of(&Summary::of(changes), changes.len())
+}
+
+/// The summary line of `total` changes counted in `s`.
+pub(crate) fn summary_of(s: &Summary, total: usize) -> String {
     format!(
         "{total} change{}: {} breaking, {} additive, {} compatible",
         if total == 1 { "" } else { "s" },
@@ -91,7 +94,7 @@ pub fn markdown(old: &str, new: &str, changes: &[Change]) -> String {
 
 /// Text that is safe inside a Markdown table cell (names in it are code
 /// spans already, [`code_span`]): pipes escaped, one line, terminal-safe.
-fn md(text: &str) -> String {
+pub(crate) fn md(text: &str) -> String {
     terminal_line(&text.replace(['\n', '\r'], " ")).replace('|', "\\|")
 }
 
@@ -135,7 +138,7 @@ pub fn json(old: &str, new: &str, changes: &[Change]) -> String {
     out
 }
 
-fn value(v: Option<&Val>) -> String {
+pub(crate) fn value(v: Option<&Val>) -> String {
     match v {
         None => "null".into(),
         Some(Val::Bool(b)) => b.to_string(),
@@ -155,7 +158,7 @@ fn value(v: Option<&Val>) -> String {
 }
 
 /// A JSON string literal.
-fn string(text: &str) -> String {
+pub(crate) fn string(text: &str) -> String {
     let mut out = String::with_capacity(text.len() + 2);
     out.push('"');
     for c in text.chars() {

@@ -3,23 +3,28 @@
 //! ([`config`]), checked as a whole, and written as master.dcf and concise
 //! DCFs.
 
+pub mod api;
 pub mod check;
 pub mod config;
 mod configure;
 pub use configure::configure;
 pub mod configured;
 pub mod dcf;
+pub mod diff;
 mod expand;
 pub mod model;
 mod pdo;
 mod pdo_config;
 mod read;
+pub mod sniff;
 mod values;
 mod view;
 mod yaml;
 
 #[cfg(test)]
 mod tests;
+
+pub use sniff::is_bus_file;
 
 use std::path::{Path, PathBuf};
 
