@@ -1,6 +1,7 @@
-//! The python-canopen oracle: a virtual environment that the tests create by
-//! themselves on first use, under the target directory, with the pinned
-//! packages of `tests/python/requirements.txt`.
+//! The Python oracles (python-canopen, and lely's dcfgen from dcf-tools): a
+//! virtual environment that the tests create by themselves on first use,
+//! under the target directory, with the pinned packages of
+//! `tests/python/requirements.txt`.
 //!
 //! Creation is guarded by a file lock, so parallel test processes share one
 //! environment. Any failure is an error with the reason: tests that need the
@@ -60,6 +61,21 @@ pub fn python() -> Result<PathBuf, String> {
     fs::write(&stamp, &requirements)
         .map_err(|e| format!("cannot write {}: {e}", stamp.display()))?;
     Ok(interpreter)
+}
+
+/// Path of lely's `dcfgen` in the oracle's environment (dcf-tools, pinned
+/// in `tests/python/requirements.txt`), creating the environment first.
+pub fn dcfgen() -> Result<PathBuf, String> {
+    let python = python()?;
+    let dcfgen = python.with_file_name("dcfgen");
+    if dcfgen.exists() {
+        Ok(dcfgen)
+    } else {
+        Err(format!(
+            "{} is missing: dcf-tools did not install its command",
+            dcfgen.display()
+        ))
+    }
 }
 
 fn run(command: &mut Command, what: &str) -> Result<(), String> {

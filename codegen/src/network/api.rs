@@ -208,6 +208,8 @@ mod tests {
             inhibit_time: 0,
             event_timer: 0,
             sync_start: 0,
+            master_event_timer: 0,
+            master_sync_start: 0,
             mapping: vec![
                 MappedObject {
                     index: 0x6041,

@@ -33,6 +33,12 @@ pub struct Node {
     /// The PDOs the node transmits (its TPDOs), valid and mapped ones only,
     /// by number.
     pub tpdos: Vec<Pdo>,
+    /// The PDOs the bus file disables (`enabled: false`) whose device-file
+    /// COB-ID was valid and whose mapping is not empty, by number: dcfgen
+    /// keeps them valid in master.dcf; `net dcf` mirrors them there under
+    /// their numbers, not valid. Not part of the running network.
+    pub disabled_rpdos: Vec<Pdo>,
+    pub disabled_tpdos: Vec<Pdo>,
     /// The node's concise DCF (`NAME.bin`) in dcfgen's order; empty when
     /// dcfgen writes no file for it.
     pub concise: Vec<ConciseEntry>,
@@ -76,6 +82,13 @@ pub struct Pdo {
     pub inhibit_time: u16,
     pub event_timer: u16,
     pub sync_start: u8,
+    /// Sub 5 of the master's mirror of this PDO in master.dcf: for a
+    /// slave's RPDO (a master TPDO) the bus file's `event_timer`, for a
+    /// slave's TPDO (a master RPDO) its `event_deadline`; 0 when absent.
+    pub master_event_timer: u16,
+    /// Sub 6 of the master TPDO that mirrors a slave's RPDO: the bus file's
+    /// `sync_start` (0 when absent).
+    pub master_sync_start: u8,
     pub mapping: Vec<MappedObject>,
     /// Where the bus file configures it (`None`: the device file's default).
     pub spot: Option<Spot>,

@@ -76,6 +76,8 @@ fn configure_slave(
         node_id: view.node_id,
         rpdos: Vec::new(),
         tpdos: Vec::new(),
+        disabled_rpdos: Vec::new(),
+        disabled_tpdos: Vec::new(),
         concise: Vec::new(),
         heartbeat_producer: view
             .integer(0x1017, 0)
@@ -109,10 +111,14 @@ fn configure_slave(
             .as_ref()
             .and_then(|c| c.lss_serial_number)
             .unwrap_or_else(|| from_1018(4)),
-        dcf_path: slave
-            .dcf_path
-            .as_ref()
-            .map_or_else(|| bus.options.dcf_path.clone(), |p| p.value.clone()),
+        // dcfgen expands environment variables in dcf_path.
+        dcf_path: expand_vars(
+            slave
+                .dcf_path
+                .as_ref()
+                .map_or(&bus.options.dcf_path, |p| &p.value),
+            |name| std::env::var(name).ok(),
+        ),
         configuration_file: String::new(),
     };
     identity_override(
@@ -191,8 +197,8 @@ fn configure_slave(
             }
         }
     }
-    node.rpdos = configure_pdos(state, &slave.rpdo, 0x1400, next_auto);
-    node.tpdos = configure_pdos(state, &slave.tpdo, 0x1800, next_auto);
+    (node.rpdos, node.disabled_rpdos) = configure_pdos(state, &slave.rpdo, 0x1400, next_auto);
+    (node.tpdos, node.disabled_tpdos) = configure_pdos(state, &slave.tpdo, 0x1800, next_auto);
 
     if let Some(v) = &slave.software_version
         && state.view.entry(0x1F56, 1).is_none()
@@ -282,18 +288,23 @@ fn configure_pdos(
     sections: &std::collections::BTreeMap<u16, super::model::PdoSection>,
     first_comm: u16,
     next_auto: &mut u32,
-) -> Vec<super::config::Pdo> {
+) -> (Vec<super::config::Pdo>, Vec<super::config::Pdo>) {
     let kind = if first_comm == 0x1800 { "TPDO" } else { "RPDO" };
     let mut pdos: Vec<_> = (0..512u16)
         .filter(|i| state.view.has_object(first_comm + i))
         .map(|i| state.device_pdo(first_comm + i, i + 1))
         .collect();
     // dcfgen applies the sections in the order the file writes them.
+    let mut disabled = Vec::new();
     let mut ordered: Vec<_> = sections.iter().collect();
     ordered.sort_by_key(|(number, section)| (section.spot.line, **number));
     for (&number, section) in ordered {
         match pdos.iter_mut().find(|p| p.number == number) {
-            Some(pdo) => state.apply(pdo, first_comm + number - 1, section, next_auto),
+            Some(pdo) => {
+                if state.apply(pdo, first_comm + number - 1, section, next_auto) {
+                    disabled.push(number);
+                }
+            }
             None => {
                 let message = format!(
                     "the device file has no {kind} {number} (no object 0x{:04X}); its PDOs are {}",
@@ -304,8 +315,13 @@ fn configure_pdos(
             }
         }
     }
-    pdos.retain(|p| p.cob_id & INVALID == 0 && !p.mapping.is_empty());
-    pdos
+    // dcfgen keeps a disabled PDO whose COB-ID was valid in master.dcf.
+    let (disabled, mut pdos): (Vec<_>, Vec<_>) = pdos
+        .into_iter()
+        .filter(|p| !p.mapping.is_empty())
+        .partition(|p| disabled.contains(&p.number));
+    pdos.retain(|p| p.cob_id & INVALID == 0);
+    (pdos, disabled)
 }
 
 fn list_numbers(pdos: &[super::config::Pdo]) -> String {
@@ -437,10 +453,39 @@ fn configure_master(
 }
 
 /// `dir` and `file` joined with `/` as dcfgen joins them (`os.path.join`).
-fn join(dir: &str, file: &str) -> String {
+pub(crate) fn join(dir: &str, file: &str) -> String {
     if dir.is_empty() || dir.ends_with('/') {
         format!("{dir}{file}")
     } else {
         format!("{dir}/{file}")
     }
+}
+
+/// `$NAME` and `${NAME}` replaced by the variable's value where it is set
+/// (`NAME` of letters, digits and `_`); the rest kept as written.
+pub(crate) fn expand_vars(text: &str, var: impl Fn(&str) -> Option<String>) -> String {
+    let mut out = String::new();
+    let mut rest = text;
+    while let Some(at) = rest.find('$') {
+        out.push_str(&rest[..at]);
+        let after = &rest[at + 1..];
+        let (name, len) = if let Some(inner) = after.strip_prefix('{') {
+            match inner.find('}') {
+                Some(end) => (&inner[..end], end + 2),
+                None => ("", 0),
+            }
+        } else {
+            let end = after
+                .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+                .unwrap_or(after.len());
+            (&after[..end], end)
+        };
+        match (len, var(name)) {
+            (1.., Some(value)) if !name.is_empty() => out.push_str(&value),
+            _ => out.push_str(&rest[at..at + 1 + len]),
+        }
+        rest = &rest[at + 1 + len..];
+    }
+    out.push_str(rest);
+    out
 }

@@ -9,6 +9,7 @@ pub mod config;
 mod configure;
 pub use configure::configure;
 pub mod configured;
+pub mod dcf;
 pub mod diff;
 mod expand;
 pub mod model;

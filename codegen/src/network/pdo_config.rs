@@ -125,6 +125,8 @@ impl SlaveState<'_> {
             inhibit_time: 0,
             event_timer: 0,
             sync_start: 0,
+            master_event_timer: 0,
+            master_sync_start: 0,
             mapping: Vec::new(),
             spot: None,
         };
@@ -163,8 +165,15 @@ impl SlaveState<'_> {
 
     /// Applies one `rpdo`/`tpdo` section to `pdo`, appending the writes.
     /// `next_auto` is the next free COB-ID for `cob_id: auto` beyond the
-    /// pre-defined ones.
-    pub fn apply(&mut self, pdo: &mut Pdo, comm: u16, section: &PdoSection, next_auto: &mut u32) {
+    /// pre-defined ones. True when the section disables a PDO whose COB-ID
+    /// was valid (dcfgen keeps such a PDO in master.dcf).
+    pub fn apply(
+        &mut self,
+        pdo: &mut Pdo,
+        comm: u16,
+        section: &PdoSection,
+        next_auto: &mut u32,
+    ) -> bool {
         let tpdo = is_tpdo(comm);
         let before = pdo.cob_id;
         pdo.spot = Some(section.spot.clone());
@@ -225,7 +234,21 @@ impl SlaveState<'_> {
                     pdo.sync_start = t.value;
                     self.write(comm, 6, i128::from(t.value), &t.spot);
                 }
-            } else if let Some(t) = &section.event_deadline
+                // The master's mirror (an RPDO) watches the deadline.
+                if let Some(t) = &section.event_deadline {
+                    pdo.master_event_timer = t.value;
+                }
+            } else {
+                // The master's mirror (a TPDO) sends on these.
+                if let Some(t) = &section.event_timer {
+                    pdo.master_event_timer = t.value;
+                }
+                if let Some(t) = &section.sync_start {
+                    pdo.master_sync_start = t.value;
+                }
+            }
+            if !tpdo
+                && let Some(t) = &section.event_deadline
                 && t.value != pdo.event_timer
             {
                 // Sub 5 of an RPDO is its event deadline (dcfgen 2.4.2
@@ -241,8 +264,10 @@ impl SlaveState<'_> {
             } else {
                 // Written invalid above and left so: the PDO does not run.
                 pdo.cob_id |= INVALID;
+                return true;
             }
         }
+        false
     }
 
     fn map(&mut self, pdo: &mut Pdo, map: u16, items: &[super::model::MappingItem], spot: &Spot) {

@@ -16,6 +16,8 @@ fn node(rpdos: Vec<Pdo>, tpdos: Vec<Pdo>) -> Node {
         node_id: 32,
         rpdos,
         tpdos,
+        disabled_rpdos: Vec::new(),
+        disabled_tpdos: Vec::new(),
         concise: Vec::new(),
         heartbeat_producer: 100,
         guard_time: 0,
@@ -41,6 +43,8 @@ fn pdo(number: u16, cob_id: u32, mapping: &[u32]) -> Pdo {
         inhibit_time: 0,
         event_timer: 0,
         sync_start: 0,
+        master_event_timer: 0,
+        master_sync_start: 0,
         mapping: mapping.iter().map(|&r| MappedObject::from_raw(r)).collect(),
         spot: None,
     }

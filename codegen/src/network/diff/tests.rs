@@ -57,6 +57,8 @@ fn pdo(number: u16, cob_id: u32, mapping: &[(u16, u8, u8)]) -> Pdo {
         inhibit_time: 0,
         event_timer: 0,
         sync_start: 0,
+        master_event_timer: 0,
+        master_sync_start: 0,
         mapping: mapping
             .iter()
             .map(|&(index, subindex, bits)| MappedObject {
@@ -76,6 +78,8 @@ fn node(name: &str, slave: usize, node_id: u8) -> Node {
         node_id,
         rpdos: vec![pdo(1, 0x200 + u32::from(node_id), &[(0x6040, 0, 16)])],
         tpdos: vec![pdo(1, 0x180 + u32::from(node_id), &[(0x6041, 0, 16)])],
+        disabled_rpdos: Vec::new(),
+        disabled_tpdos: Vec::new(),
         concise: Vec::new(),
         heartbeat_producer: 100,
         guard_time: 0,
