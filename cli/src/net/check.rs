@@ -43,7 +43,9 @@ pub(crate) fn run(args: CheckArgs) -> ExitCode {
     let mut diagnostics = loaded.diagnostics;
     let mut load = None;
     let mut nodes = 0;
+    let mut extra = String::new();
     if let Some(bus) = &loaded.bus {
+        extra = extra_keys(bus);
         let (configured, mut found) = eds2rust::network::configure(bus);
         found.extend(check(bus, &configured, &limits));
         found.apply_levels(&options.levels, options.strict);
@@ -56,6 +58,7 @@ pub(crate) fn run(args: CheckArgs) -> ExitCode {
     if let Some(load) = load {
         text.push_str(&load.to_string());
     }
+    text.push_str(&extra);
     text.push_str(&format!(
         "{}: {} nodes, {} errors, {} warnings\n",
         eds2rust::text::terminal_line(&args.bus.display().to_string()),
@@ -71,6 +74,30 @@ pub(crate) fn run(args: CheckArgs) -> ExitCode {
     } else {
         ExitCode::SUCCESS
     }
+}
+
+/// The keys dcfgen does not use (ros2_canopen's `driver`, `package`, ...),
+/// listed at info level: kept, never an error.
+fn extra_keys(bus: &eds2rust::network::model::Bus) -> String {
+    if bus.extra_keys.is_empty() {
+        return String::new();
+    }
+    let path = bus.file.display().to_string();
+    let file = eds2rust::text::terminal_line(&path);
+    let mut text = format!(
+        "info: {} keys that dcfgen does not use (kept for other tools, such as ros2_canopen's drivers):\n",
+        bus.extra_keys.len()
+    );
+    for key in &bus.extra_keys {
+        text.push_str(&format!(
+            "  {file}:{}: {}.{} = {}\n",
+            key.spot.line,
+            eds2rust::text::terminal_line(&key.section),
+            eds2rust::text::terminal_line(&key.key),
+            eds2rust::text::terminal_line(&key.value)
+        ));
+    }
+    text
 }
 
 fn usage(message: &str) -> ExitCode {

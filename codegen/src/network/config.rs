@@ -114,6 +114,19 @@ pub fn can_id(raw: u32) -> (u32, bool) {
     }
 }
 
+/// A heartbeat consumer time as dcfgen computes it from a producer time
+/// (ms) and a multiplier: the product truncated towards zero (Python's
+/// `int()`), 0 when negative or not a number. Where it goes into a 16-bit
+/// entry, dcfgen keeps the low 16 bits.
+pub fn heartbeat_product(time: u16, multiplier: f64) -> u64 {
+    let product = f64::from(time) * multiplier;
+    if product.is_nan() || product <= 0.0 {
+        0
+    } else {
+        product as u64
+    }
+}
+
 /// One entry of a concise DCF.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ConciseEntry {

@@ -342,7 +342,10 @@ fn configure_master(
     nodes: &mut [Node],
     diagnostics: &mut Diagnostics,
 ) -> Vec<ConciseEntry> {
-    let heartbeat = (f64::from(master.heartbeat_producer) * master.heartbeat_multiplier) as i128;
+    let heartbeat = i128::from(super::config::heartbeat_product(
+        master.heartbeat_producer,
+        master.heartbeat_multiplier,
+    ));
     for node in nodes.iter_mut() {
         let slave = &bus.slaves[node.slave];
         let mut state = SlaveState {

@@ -26,12 +26,7 @@ pub(super) fn check(net: &Net, report: &mut Report<'_>) {
 /// and the untruncated product.
 fn consumer_time(producer: u16, multiplier: f64) -> (u16, f64) {
     let product = f64::from(producer) * multiplier;
-    // Python's int(): towards zero; then & 0xFFFF.
-    let whole = if product.is_finite() && product > 0.0 {
-        product.trunc().min(u64::MAX as f64) as u64
-    } else {
-        0
-    };
+    let whole = crate::network::config::heartbeat_product(producer, multiplier);
     ((whole & 0xFFFF) as u16, product)
 }
 

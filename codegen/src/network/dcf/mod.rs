@@ -144,16 +144,7 @@ fn consumer_heartbeat_time(
     })
 }
 
-/// `time × multiplier` truncated towards zero (Python's `int()`), 0 when
-/// negative or not a number.
-pub fn heartbeat_product(time: u16, multiplier: f64) -> u64 {
-    let product = f64::from(time) * multiplier;
-    if product.is_nan() || product <= 0.0 {
-        0
-    } else {
-        product as u64
-    }
-}
+pub use super::config::heartbeat_product;
 
 #[cfg(test)]
 mod tests;

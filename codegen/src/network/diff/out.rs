@@ -120,7 +120,7 @@ pub(super) fn hex_val(v: u32) -> Val {
 /// How long a consumer waits for a heartbeat produced every `producer` ms
 /// (dcfgen: the producer time times the multiplier, truncated to 16 bits).
 pub(super) fn consumer_time(producer: u16, multiplier: f64) -> u64 {
-    ((f64::from(producer) * multiplier) as u64) & 0xFFFF
+    crate::network::config::heartbeat_product(producer, multiplier) & 0xFFFF
 }
 
 /// One side of a node pair: the bus, the configured node, its section.
