@@ -24,33 +24,14 @@ fn slave(name: &str, dir: &Path, dcf: &str, node_id: u8) -> SlaveSection {
     let path = dir.join(dcf);
     let loaded = read_device(&path, &Options::lenient());
     SlaveSection {
-        name: name.to_string(),
-        spot: spot(name),
-        dcf: at(dcf.to_string()),
-        device_file: path.clone(),
-        device: Box::new(loaded.device.expect("device reads")),
         node_id: Some(at(node_id)),
-        dcf_path: None,
-        revision_number: None,
-        serial_number: None,
-        time_cob_id: None,
-        heartbeat_multiplier: None,
-        heartbeat_consumer: None,
-        heartbeat_producer: None,
-        retry_factor: None,
-        guard_time: None,
-        life_time_factor: None,
-        error_behavior: BTreeMap::new(),
-        rpdo: BTreeMap::new(),
-        tpdo: BTreeMap::new(),
-        boot: None,
-        mandatory: None,
-        reset_communication: None,
-        software_file: None,
-        software_version: None,
-        configuration_file: None,
-        restore_configuration: None,
-        sdo: Vec::new(),
+        ..SlaveSection::new(
+            name.to_string(),
+            spot(name),
+            at(dcf.to_string()),
+            path.clone(),
+            Box::new(loaded.device.expect("device reads")),
+        )
     }
 }
 

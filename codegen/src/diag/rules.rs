@@ -224,7 +224,10 @@ pub const RULES: &[Rule] = &[
         "net::no-such-pdo",
         "an rpdo/tpdo number the device file has no PDO for",
     ),
-    rule("net::node-id", "a node id outside 1..=127 in a bus file"),
+    rule(
+        "net::node-id",
+        "a node id outside 1..=127 in a bus file, or a master without one",
+    ),
     rule("net::node-id-collision", "two nodes with one node id"),
     rule(
         "net::not-writable",

@@ -311,3 +311,44 @@ impl Spot {
         }
     }
 }
+
+impl SlaveSection {
+    /// A section that gives only its device file: every other key absent.
+    pub fn new(
+        name: String,
+        spot: Spot,
+        dcf: At<String>,
+        device_file: PathBuf,
+        device: Box<Device>,
+    ) -> Self {
+        SlaveSection {
+            name,
+            spot,
+            dcf,
+            device_file,
+            device,
+            node_id: None,
+            dcf_path: None,
+            revision_number: None,
+            serial_number: None,
+            time_cob_id: None,
+            heartbeat_multiplier: None,
+            heartbeat_consumer: None,
+            heartbeat_producer: None,
+            retry_factor: None,
+            guard_time: None,
+            life_time_factor: None,
+            error_behavior: BTreeMap::new(),
+            rpdo: BTreeMap::new(),
+            tpdo: BTreeMap::new(),
+            boot: None,
+            mandatory: None,
+            reset_communication: None,
+            software_file: None,
+            software_version: None,
+            configuration_file: None,
+            restore_configuration: None,
+            sdo: Vec::new(),
+        }
+    }
+}

@@ -294,33 +294,13 @@ fn slave(
         key: name.to_string(),
     };
     let mut s = SlaveSection {
-        name: name.to_string(),
-        spot,
-        dcf: at(String::new(), &source_entry(source)),
-        device_file: PathBuf::new(),
-        device: Box::default(),
-        node_id: None,
-        dcf_path: None,
-        revision_number: None,
-        serial_number: None,
-        time_cob_id: None,
-        heartbeat_multiplier: None,
-        heartbeat_consumer: None,
-        heartbeat_producer: None,
-        retry_factor: None,
-        guard_time: None,
-        life_time_factor: None,
-        error_behavior: BTreeMap::new(),
-        rpdo: BTreeMap::new(),
-        tpdo: BTreeMap::new(),
-        boot: None,
-        mandatory: None,
-        reset_communication: None,
-        software_file: None,
-        software_version: None,
-        configuration_file: None,
-        restore_configuration: None,
-        sdo: Vec::new(),
+        ..SlaveSection::new(
+            name.to_string(),
+            spot,
+            at(String::new(), &source_entry(source)),
+            PathBuf::new(),
+            Box::default(),
+        )
     };
     let mut dcf: Option<(String, Entry)> = None;
     let mut dcf_written = false;

@@ -1,7 +1,6 @@
 //! The checks on buses built by hand (the fixtures under
 //! tests/networks/check/ run them on bus files read from disk).
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use super::*;
@@ -30,33 +29,14 @@ fn device() -> Box<crate::ir::Device> {
 
 fn slave(name: &str, node_id: u8, line: u32) -> SlaveSection {
     SlaveSection {
-        name: name.to_string(),
-        spot: spot(line, name),
-        dcf: at("device.yaml".into(), line + 1, &format!("{name}.dcf")),
-        device_file: "device.yaml".into(),
-        device: device(),
         node_id: Some(at(node_id, line + 2, &format!("{name}.node_id"))),
-        dcf_path: None,
-        revision_number: None,
-        serial_number: None,
-        time_cob_id: None,
-        heartbeat_multiplier: None,
-        heartbeat_consumer: None,
-        heartbeat_producer: None,
-        retry_factor: None,
-        guard_time: None,
-        life_time_factor: None,
-        error_behavior: BTreeMap::new(),
-        rpdo: BTreeMap::new(),
-        tpdo: BTreeMap::new(),
-        boot: None,
-        mandatory: None,
-        reset_communication: None,
-        software_file: None,
-        software_version: None,
-        configuration_file: None,
-        restore_configuration: None,
-        sdo: Vec::new(),
+        ..SlaveSection::new(
+            name.to_string(),
+            spot(line, name),
+            at("device.yaml".into(), line + 1, &format!("{name}.dcf")),
+            "device.yaml".into(),
+            device(),
+        )
     }
 }
 

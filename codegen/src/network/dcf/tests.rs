@@ -81,33 +81,13 @@ fn device() -> Device {
 
 fn slave(name: &str) -> SlaveSection {
     SlaveSection {
-        name: name.to_string(),
-        spot: Spot::default(),
-        dcf: At::new("dev.eds".to_string(), Spot::default()),
-        device_file: PathBuf::from("dev.eds"),
-        device: Box::new(device()),
-        node_id: None,
-        dcf_path: None,
-        revision_number: None,
-        serial_number: None,
-        time_cob_id: None,
-        heartbeat_multiplier: None,
-        heartbeat_consumer: None,
-        heartbeat_producer: None,
-        retry_factor: None,
-        guard_time: None,
-        life_time_factor: None,
-        error_behavior: BTreeMap::new(),
-        rpdo: BTreeMap::new(),
-        tpdo: BTreeMap::new(),
-        boot: None,
-        mandatory: None,
-        reset_communication: None,
-        software_file: None,
-        software_version: None,
-        configuration_file: None,
-        restore_configuration: None,
-        sdo: Vec::new(),
+        ..SlaveSection::new(
+            name.to_string(),
+            Spot::default(),
+            At::new("dev.eds".to_string(), Spot::default()),
+            PathBuf::from("dev.eds"),
+            Box::new(device()),
+        )
     }
 }
 

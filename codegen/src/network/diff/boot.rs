@@ -149,35 +149,19 @@ pub(super) fn settings(o: &mut Out, (_, on, os): Side, (_, nn, ns): Side) {
             get(ns).as_ref(),
         );
     }
-    o.setting("boot", at_value(&os.boot), at_value(&ns.boot));
-    o.setting(
-        "mandatory",
-        at_value(&os.mandatory),
-        at_value(&ns.mandatory),
-    );
-    o.setting(
-        "reset_communication",
-        at_value(&os.reset_communication),
-        at_value(&ns.reset_communication),
-    );
-    o.setting(
-        "software_file",
-        at_value(&os.software_file),
-        at_value(&ns.software_file),
-    );
-    o.setting(
-        "software_version",
-        at_value(&os.software_version),
-        at_value(&ns.software_version),
-    );
-    o.setting(
-        "configuration_file",
-        at_value(&os.configuration_file),
-        at_value(&ns.configuration_file),
-    );
-    o.setting(
-        "restore_configuration",
-        at_value(&os.restore_configuration),
-        at_value(&ns.restore_configuration),
+    // The boot keys, compared as written.
+    macro_rules! settings {
+        ($($key:ident),*) => {
+            $(o.setting(stringify!($key), at_value(&os.$key), at_value(&ns.$key));)*
+        };
+    }
+    settings!(
+        boot,
+        mandatory,
+        reset_communication,
+        software_file,
+        software_version,
+        configuration_file,
+        restore_configuration
     );
 }

@@ -1,8 +1,6 @@
 //! The wiring rules on hand-built networks: each change alone, with its
 //! kind and severity.
 
-use std::collections::BTreeMap;
-
 use super::*;
 use crate::diff::Severity::{Additive, Breaking, Compatible};
 use crate::ir::pdo::MappedObject;
@@ -19,33 +17,13 @@ fn slave(name: &str) -> SlaveSection {
     device.identity.product_number = Some(1);
     device.identity.revision_number = Some(2);
     SlaveSection {
-        name: name.into(),
-        spot: Spot::default(),
-        dcf: at(format!("{name}.eds")),
-        device_file: format!("{name}.eds").into(),
-        device: Box::new(device),
-        node_id: None,
-        dcf_path: None,
-        revision_number: None,
-        serial_number: None,
-        time_cob_id: None,
-        heartbeat_multiplier: None,
-        heartbeat_consumer: None,
-        heartbeat_producer: None,
-        retry_factor: None,
-        guard_time: None,
-        life_time_factor: None,
-        error_behavior: BTreeMap::new(),
-        rpdo: BTreeMap::new(),
-        tpdo: BTreeMap::new(),
-        boot: None,
-        mandatory: None,
-        reset_communication: None,
-        software_file: None,
-        software_version: None,
-        configuration_file: None,
-        restore_configuration: None,
-        sdo: Vec::new(),
+        ..SlaveSection::new(
+            name.into(),
+            Spot::default(),
+            at(format!("{name}.eds")),
+            format!("{name}.eds").into(),
+            Box::new(device),
+        )
     }
 }
 
