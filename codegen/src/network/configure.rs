@@ -44,6 +44,7 @@ pub fn configure(bus: &Bus) -> (Configured, Diagnostics) {
             name: &slave.name,
             bus_file: &bus.file,
             concise: Vec::new(),
+            not_writable: Vec::new(),
             diagnostics: &mut diagnostics,
         };
         let node = configure_slave(&mut state, bus, slave, position, &mut next_auto);
@@ -356,6 +357,7 @@ fn configure_master(
             name: &slave.name,
             bus_file: &bus.file,
             concise: std::mem::take(&mut node.concise),
+            not_writable: Vec::new(),
             diagnostics,
         };
         let consumers: Vec<(u8, i128)> = state

@@ -24,6 +24,9 @@ pub(crate) struct SlaveState<'a> {
     pub name: &'a str,
     pub bus_file: &'a Path,
     pub concise: Vec<ConciseEntry>,
+    /// The entries reported not writable already (one word per entry, not
+    /// per write: a mapping's sub 0 is written twice).
+    pub not_writable: Vec<(u16, u8)>,
     pub diagnostics: &'a mut Diagnostics,
 }
 
@@ -77,7 +80,8 @@ impl SlaveState<'_> {
             return None;
         };
         let (data_type, writable) = (entry.data_type, entry.access.is_writable());
-        if !writable {
+        if !writable && !self.not_writable.contains(&(index, sub)) {
+            self.not_writable.push((index, sub));
             let message = format!(
                 "0x{index:04X}/{sub} is not writable; the write will be refused by the device"
             );

@@ -78,9 +78,6 @@ fn master_consumes(net: &Net, report: &mut Report<'_>) {
             .heartbeat_multiplier
             .as_ref()
             .map_or(net.bus.options.heartbeat_multiplier, |m| m.value);
-        let Some(problem) = timing_problem(producer, multiplier) else {
-            continue;
-        };
         let spot = first_spot(
             &[
                 slave.heartbeat_multiplier.as_ref().map(|m| &m.spot),
@@ -88,6 +85,24 @@ fn master_consumes(net: &Net, report: &mut Report<'_>) {
             ],
             &slave.spot,
         );
+        let (wrapped, product) = consumer_time(producer, multiplier);
+        if product >= 65536.0 {
+            // `net dcf` writes the longest time 0x1016 holds (a deliberate
+            // difference); dcfgen's master.dcf would have the cut one.
+            report.warning(
+                "net::heartbeat-timing",
+                &spot,
+                format!(
+                    "the master's consumer time for `{}`'s heartbeat, {producer} ms × {multiplier} = {product} ms, does not fit the 16 bits of 0x1016: `eds2rust net dcf` writes 65535 ms, dcfgen 2.4.2 writes {wrapped} ms, shorter than the heartbeat period",
+                    node.name
+                ),
+                vec![timing_fix(producer)],
+            );
+            continue;
+        }
+        let Some(problem) = timing_problem(producer, multiplier) else {
+            continue;
+        };
         report.error(
             "net::heartbeat-timing",
             &spot,
