@@ -9,6 +9,27 @@
 
 use std::borrow::Cow;
 
+/// Where an input stops being UTF-8.
+pub(crate) struct NotUtf8 {
+    /// The 0-based offset of the first byte that is not UTF-8.
+    pub byte: usize,
+    /// Its 1-based line.
+    pub line: u32,
+}
+
+/// An input's bytes as UTF-8 text without a leading byte-order mark.
+pub(crate) fn decode_utf8(bytes: &[u8]) -> Result<&str, NotUtf8> {
+    match std::str::from_utf8(bytes) {
+        Ok(text) => Ok(text.strip_prefix('\u{feff}').unwrap_or(text)),
+        Err(err) => {
+            let byte = err.valid_up_to();
+            let lines = bytes[..byte].iter().filter(|&&b| b == b'\n').count();
+            let line = u32::try_from(lines).unwrap_or(u32::MAX).saturating_add(1);
+            Err(NotUtf8 { byte, line })
+        }
+    }
+}
+
 /// Whether `c` is a bidirectional-text control: U+202A–U+202E
 /// (embeddings, overrides), U+2066–U+2069 (isolates), U+200E/U+200F (marks)
 /// and U+061C (Arabic letter mark).

@@ -201,34 +201,24 @@ mod tests {
 
     #[test]
     fn a_mapping_lists_bit_ranges_gaps_and_unknown_entries() {
-        let pdo = Pdo {
-            number: 1,
-            cob_id: 0x181,
-            transmission: 1,
-            inhibit_time: 0,
-            event_timer: 0,
-            sync_start: 0,
-            master_event_timer: 0,
-            master_sync_start: 0,
-            mapping: vec![
-                MappedObject {
-                    index: 0x6041,
-                    subindex: 0,
-                    bits: 16,
-                },
-                MappedObject {
-                    index: 0x0005,
-                    subindex: 0,
-                    bits: 8,
-                },
-                MappedObject {
-                    index: 0x2000,
-                    subindex: 3,
-                    bits: 32,
-                },
-            ],
-            spot: None,
-        };
+        let mapped = vec![
+            MappedObject {
+                index: 0x6041,
+                subindex: 0,
+                bits: 16,
+            },
+            MappedObject {
+                index: 0x0005,
+                subindex: 0,
+                bits: 8,
+            },
+            MappedObject {
+                index: 0x2000,
+                subindex: 3,
+                bits: 32,
+            },
+        ];
+        let pdo = Pdo::new(1, 0x181, 1, mapped);
         assert_eq!(
             mapping(&pdo, &DeviceNames::default()),
             "0x6041.0@0..16, dummy 0x0005@16..24, 0x2000.3@24..56"

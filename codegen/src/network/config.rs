@@ -95,6 +95,24 @@ pub struct Pdo {
 }
 
 impl Pdo {
+    /// A PDO with this number, COB-ID entry value, transmission type and
+    /// mapping; no inhibit time, timers or SYNC start value, not from the
+    /// bus file.
+    pub fn new(number: u16, cob_id: u32, transmission: u8, mapping: Vec<MappedObject>) -> Pdo {
+        Pdo {
+            number,
+            cob_id,
+            transmission,
+            inhibit_time: 0,
+            event_timer: 0,
+            sync_start: 0,
+            master_event_timer: 0,
+            master_sync_start: 0,
+            mapping,
+            spot: None,
+        }
+    }
+
     /// The CAN identifier the PDO is sent on, and whether it is a 29-bit one.
     pub fn can_id(&self) -> (u32, bool) {
         can_id(self.cob_id)

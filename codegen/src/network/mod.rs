@@ -108,14 +108,9 @@ fn read_text(
     diagnostics: &mut Diagnostics,
     devices: &mut read::Devices,
 ) -> Option<model::Bus> {
-    let text = match std::str::from_utf8(bytes) {
-        Ok(text) => text.strip_prefix('\u{feff}').unwrap_or(text),
-        Err(err) => {
-            let line = bytes[..err.valid_up_to()]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count()
-                + 1;
+    let text = match crate::text::decode_utf8(bytes) {
+        Ok(text) => text,
+        Err(bad) => {
             let mut ctx = values::Ctx {
                 file: name,
                 text: "",
@@ -123,12 +118,9 @@ fn read_text(
             };
             ctx.error(
                 "net::syntax",
-                crate::table::At::line(u32::try_from(line).unwrap_or(0)),
+                crate::table::At::line(bad.line),
                 "",
-                format!(
-                    "a bus file must be UTF-8; byte {} is not",
-                    err.valid_up_to()
-                ),
+                format!("a bus file must be UTF-8; byte {} is not", bad.byte),
             );
             return None;
         }

@@ -120,20 +120,11 @@ impl SlaveState<'_> {
                 None
             }
         };
-        let mut pdo = Pdo {
-            number,
-            cob_id: sub(1)
-                .and_then(|c| u32::try_from(c).ok())
-                .unwrap_or(INVALID),
-            transmission: sub(2).and_then(|t| u8::try_from(t).ok()).unwrap_or(0),
-            inhibit_time: 0,
-            event_timer: 0,
-            sync_start: 0,
-            master_event_timer: 0,
-            master_sync_start: 0,
-            mapping: Vec::new(),
-            spot: None,
-        };
+        let cob_id = sub(1)
+            .and_then(|c| u32::try_from(c).ok())
+            .unwrap_or(INVALID);
+        let transmission = sub(2).and_then(|t| u8::try_from(t).ok()).unwrap_or(0);
+        let mut pdo = Pdo::new(number, cob_id, transmission, Vec::new());
         if tpdo {
             pdo.inhibit_time = sub(3).and_then(|t| u16::try_from(t).ok()).unwrap_or(0);
             pdo.sync_start = sub(6).and_then(|t| u8::try_from(t).ok()).unwrap_or(0);

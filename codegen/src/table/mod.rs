@@ -92,26 +92,18 @@ fn read_table(file: &str, bytes: &[u8], base: Base) -> Loaded {
     let mut files = Vec::new();
     let mut levels = crate::diag::Levels::new();
     let mut diagnostics = Diagnostics::new();
-    let text = match std::str::from_utf8(bytes) {
-        Ok(text) => text.strip_prefix('\u{feff}').unwrap_or(text),
-        Err(err) => {
-            let line = bytes[..err.valid_up_to()]
-                .iter()
-                .filter(|&&b| b == b'\n')
-                .count()
-                + 1;
+    let text = match crate::text::decode_utf8(bytes) {
+        Ok(text) => text,
+        Err(bad) => {
             diagnostics.push(Diagnostic {
                 severity: Severity::Error,
                 code: "table::not-utf8",
                 file: file.to_string(),
                 location: Location {
-                    line: u32::try_from(line).ok(),
+                    line: Some(bad.line),
                     ..Location::default()
                 },
-                message: format!(
-                    "a YAML table must be UTF-8; byte {} is not",
-                    err.valid_up_to()
-                ),
+                message: format!("a YAML table must be UTF-8; byte {} is not", bad.byte),
                 notes: Vec::new(),
             });
             return Loaded {

@@ -36,18 +36,8 @@ fn node(rpdos: Vec<Pdo>, tpdos: Vec<Pdo>) -> Node {
 }
 
 fn pdo(number: u16, cob_id: u32, mapping: &[u32]) -> Pdo {
-    Pdo {
-        number,
-        cob_id,
-        transmission: 1,
-        inhibit_time: 0,
-        event_timer: 0,
-        sync_start: 0,
-        master_event_timer: 0,
-        master_sync_start: 0,
-        mapping: mapping.iter().map(|&r| MappedObject::from_raw(r)).collect(),
-        spot: None,
-    }
+    let mapping = mapping.iter().map(|&r| MappedObject::from_raw(r)).collect();
+    Pdo::new(number, cob_id, 1, mapping)
 }
 
 fn configured_value(device: &Device, index: u16, sub: u8) -> Option<i128> {

@@ -28,25 +28,15 @@ fn slave(name: &str) -> SlaveSection {
 }
 
 fn pdo(number: u16, cob_id: u32, mapping: &[(u16, u8, u8)]) -> Pdo {
-    Pdo {
-        number,
-        cob_id,
-        transmission: 1,
-        inhibit_time: 0,
-        event_timer: 0,
-        sync_start: 0,
-        master_event_timer: 0,
-        master_sync_start: 0,
-        mapping: mapping
-            .iter()
-            .map(|&(index, subindex, bits)| MappedObject {
-                index,
-                subindex,
-                bits,
-            })
-            .collect(),
-        spot: None,
-    }
+    let mapping = mapping
+        .iter()
+        .map(|&(index, subindex, bits)| MappedObject {
+            index,
+            subindex,
+            bits,
+        })
+        .collect();
+    Pdo::new(number, cob_id, 1, mapping)
 }
 
 fn node(name: &str, slave: usize, node_id: u8) -> Node {
