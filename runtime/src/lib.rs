@@ -31,6 +31,8 @@ extern crate alloc;
 #[cfg(all(feature = "std", not(test)))]
 extern crate std;
 
+#[cfg(feature = "alloc")]
+pub mod boot;
 pub mod cia402;
 pub mod emcy;
 pub mod frame;
