@@ -17,52 +17,20 @@
 //! the master consumes one; start the node unless the master starts all
 //! nodes at the end.
 
+mod network;
+mod plan;
 mod status;
 
 use alloc::vec::Vec;
 use core::fmt;
 
+pub use network::{NetworkBoot, NetworkEvent, SlaveState, SlaveStatus, Action, Configuration};
+pub use plan::{ConfigWrite, MasterPlan, NetworkPlan, PdoLink, SlaveConfig, SlavePlan, Supervision};
 pub use status::BootStatus;
 
 use crate::nmt::{NmtCommand, NmtState};
 use crate::od::NodeId;
 use crate::sdo::abort::AbortCode;
-
-/// What the network expects of one slave and how to boot it.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct SlavePlan {
-    pub node: NodeId,
-    /// 0x1000; 0 is not checked.
-    pub device_type: u32,
-    /// 0x1018 sub 1–4; 0 is not checked.
-    pub vendor_id: u32,
-    pub product_code: u32,
-    pub revision_number: u32,
-    pub serial_number: u32,
-    /// 0x1F56 sub 1 expected; 0 is not checked.
-    pub software_version: u32,
-    /// 0x1020 sub 1 and 2 (date, time) the configuration carries; `None`
-    /// always downloads it.
-    pub configuration_date_time: Option<(u32, u32)>,
-    /// The configuration, in order (a concise DCF's entries).
-    pub configuration: Vec<ConfigWrite>,
-    /// Reset before booting: `Some(ResetCommunication)` or
-    /// `Some(ResetNode)`; `None` waits for a boot-up message.
-    pub reset: Option<NmtCommand>,
-    /// Wait for a heartbeat before starting (the master consumes one).
-    pub heartbeat: bool,
-    /// Start the node when it is booted (false: the master starts all
-    /// nodes at the end).
-    pub start: bool,
-}
-
-/// One configuration write.
-#[derive(Debug, Clone, PartialEq, Eq)]
-pub struct ConfigWrite {
-    pub index: u16,
-    pub sub_index: u8,
-    pub data: Vec<u8>,
-}
 
 /// What the master is to do for the boot now.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -184,6 +152,21 @@ impl SlaveBoot {
 
     pub fn node(&self) -> NodeId {
         self.plan.node
+    }
+
+    /// The plan it boots by.
+    pub fn plan(&self) -> &SlavePlan {
+        &self.plan
+    }
+
+    /// Whether it waits for the node's boot-up message.
+    pub fn awaits_boot_up(&self) -> bool {
+        self.stage == Stage::AwaitBootUp
+    }
+
+    /// Whether it waits for the node's first heartbeat.
+    pub fn awaits_heartbeat(&self) -> bool {
+        self.stage == Stage::Heartbeat
     }
 
     /// Whether the boot is over (booted or failed).

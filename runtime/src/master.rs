@@ -49,7 +49,9 @@ use alloc::collections::BTreeMap;
 use alloc::vec::Vec;
 use core::time::Duration;
 
+use crate::boot::NetworkEvent;
 use crate::emcy::{EmcyConsumer, EmcyEvent};
+use crate::guarding::{GuardEvent, NodeGuard};
 use crate::heartbeat::{HeartbeatConsumer, HeartbeatEvent, HeartbeatProducer};
 use crate::lss::{LssEvent, LssMaster};
 use crate::nmt::{NmtEvent, NmtMaster};
@@ -76,8 +78,12 @@ pub const SYNC_EVENTS: usize = 8;
 
 /// Cores with a fixed place in the transmit rotation: NMT, heartbeat
 /// producer, heartbeat consumer, SYNC, EMCY, LSS, PDO receiver, TIME
-/// producer.
-const FIXED_CORES: usize = 8;
+/// producer, node guarding.
+const FIXED_CORES: usize = 9;
+
+mod network;
+
+pub use network::PlanError;
 
 /// What one of the master's cores reported.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -101,6 +107,10 @@ pub enum MasterEvent {
     Pdo(PdoEvent),
     /// The SDO transfer with this node ended.
     Sdo(NodeId, ClientEvent),
+    /// Node guarding saw a state, a toggle error, a loss or a return.
+    Guard(GuardEvent),
+    /// The network's boot or supervision ([`Master::boot_network`]).
+    Network(NetworkEvent),
 }
 
 /// The composite master: public cores plus one SDO client per server node.
@@ -133,6 +143,8 @@ pub struct Master {
     pub time_tx: Option<TimeProducer>,
     /// Runs LSS requests (CiA 305).
     pub lss: LssMaster,
+    /// Guards the nodes given to [`NodeGuard::guard`].
+    pub guard: NodeGuard,
     /// Receives the devices' TPDOs.
     pub pdo_rx: PdoReceiver<PDO_RX_SLOTS>,
     /// The RPDOs the master sends.
@@ -144,6 +156,7 @@ pub struct Master {
     now: Instant,
     sync_events: bool,
     sync_sent: Ring<Option<u8>, SYNC_EVENTS>,
+    network: Option<network::Running>,
 }
 
 impl Master {
@@ -161,6 +174,7 @@ impl Master {
             time_rx: Some(TimeConsumer::new()),
             time_tx: None,
             lss: LssMaster::new(),
+            guard: NodeGuard::new(),
             pdo_rx: PdoReceiver::new(),
             pdo_tx: Vec::new(),
             sdo: BTreeMap::new(),
@@ -168,6 +182,7 @@ impl Master {
             now: Instant::ZERO,
             sync_events: false,
             sync_sent: Ring::new(),
+            network: None,
         }
     }
 
@@ -306,6 +321,7 @@ impl Master {
             5 => self.lss.poll_transmit(),
             6 => self.pdo_rx.poll_transmit(),
             7 => self.time_tx.as_mut()?.poll_transmit(),
+            8 => self.guard.poll_transmit(),
             i => {
                 let i = i - FIXED_CORES;
                 match self.pdo_tx.get_mut(i) {
@@ -360,6 +376,11 @@ impl Service for Master {
         for client in self.sdo.values_mut() {
             client.handle_frame(now, frame);
         }
+        self.guard.handle_frame(now, frame);
+        if let Some(running) = &mut self.network {
+            running.boot.handle_frame(now, frame);
+            self.run_network();
+        }
     }
 
     /// Runs the timer of every core whose deadline passed.
@@ -383,6 +404,13 @@ impl Service for Master {
         for client in self.sdo.values_mut() {
             timeout_if_due(client, now);
         }
+        timeout_if_due(&mut self.guard, now);
+        if let Some(running) = &mut self.network
+            && running.boot.poll_timeout().is_some_and(|due| due <= now)
+        {
+            running.boot.handle_timeout(now);
+            self.run_network();
+        }
     }
 
     /// Takes one frame from the next core that has one, in rotation: NMT,
@@ -400,9 +428,46 @@ impl Service for Master {
         None
     }
 
-    /// Events in a fixed order of cores: NMT, heartbeat consumer, SYNC,
-    /// EMCY, TIME, LSS, PDO receiver, SDO clients by node id.
+    /// Events in a fixed order: the network's, then the cores': NMT,
+    /// heartbeat consumer, SYNC, EMCY, TIME, LSS, PDO receiver, node
+    /// guarding, SDO clients by node id. The network's boot sees each
+    /// core's event first and keeps the ends of its own SDO transfers.
     fn poll_event(&mut self) -> Option<MasterEvent> {
+        loop {
+            if let Some(event) = self.network_event() {
+                return Some(event);
+            }
+            let event = self.core_event()?;
+            if let Some(event) = self.network_sees(event) {
+                return Some(event);
+            }
+        }
+    }
+
+    /// The earliest deadline of all cores.
+    fn poll_timeout(&self) -> Option<Instant> {
+        let mut at = earliest(self.nmt.poll_timeout(), self.heartbeat.poll_timeout());
+        at = earliest(at, self.consumer.poll_timeout());
+        at = earliest(at, self.sync.as_ref().and_then(Service::poll_timeout));
+        at = earliest(at, self.emcy.poll_timeout());
+        at = earliest(at, self.lss.poll_timeout());
+        at = earliest(at, self.pdo_rx.poll_timeout());
+        at = earliest(at, self.time_tx.as_ref().and_then(Service::poll_timeout));
+        at = earliest(at, self.guard.poll_timeout());
+        at = earliest(at, self.network.as_ref().and_then(|r| r.boot.poll_timeout()));
+        for tx in &self.pdo_tx {
+            at = earliest(at, tx.poll_timeout());
+        }
+        for client in self.sdo.values() {
+            at = earliest(at, client.poll_timeout());
+        }
+        at
+    }
+}
+
+impl Master {
+    /// The next event of the cores, in their fixed order.
+    fn core_event(&mut self) -> Option<MasterEvent> {
         if let Some(e) = self.nmt.poll_event() {
             return Some(MasterEvent::Nmt(e));
         }
@@ -424,27 +489,12 @@ impl Service for Master {
         if let Some(e) = self.pdo_rx.poll_event() {
             return Some(MasterEvent::Pdo(e));
         }
+        if let Some(e) = self.guard.poll_event() {
+            return Some(MasterEvent::Guard(e));
+        }
         self.sdo
             .iter_mut()
             .find_map(|(node, client)| client.poll_event().map(|e| MasterEvent::Sdo(*node, e)))
-    }
-
-    /// The earliest deadline of all cores.
-    fn poll_timeout(&self) -> Option<Instant> {
-        let mut at = earliest(self.nmt.poll_timeout(), self.heartbeat.poll_timeout());
-        at = earliest(at, self.consumer.poll_timeout());
-        at = earliest(at, self.sync.as_ref().and_then(Service::poll_timeout));
-        at = earliest(at, self.emcy.poll_timeout());
-        at = earliest(at, self.lss.poll_timeout());
-        at = earliest(at, self.pdo_rx.poll_timeout());
-        at = earliest(at, self.time_tx.as_ref().and_then(Service::poll_timeout));
-        for tx in &self.pdo_tx {
-            at = earliest(at, tx.poll_timeout());
-        }
-        for client in self.sdo.values() {
-            at = earliest(at, client.poll_timeout());
-        }
-        at
     }
 }
 

@@ -376,8 +376,12 @@ impl Service for NmtMaster {
         let Some(slot) = self.reported.get_mut(usize::from(node.get())) else {
             return;
         };
+        // After its boot-up message a node is Pre-operational by itself
+        // (CiA 301): that is the master's view of it from then on.
+        let booted_up = to == NmtState::BootUp;
+        let to = if booted_up { NmtState::PreOperational } else { to };
         let from = slot.replace(to);
-        if to == NmtState::BootUp {
+        if booted_up {
             self.events.push(NmtEvent::BootUp(node));
         }
         if from != Some(to) {
@@ -539,20 +543,18 @@ mod tests {
                 NmtEvent::StateChanged {
                     node: node(32),
                     from: None,
-                    to: NmtState::BootUp
+                    to: NmtState::PreOperational
                 }
             ]
         );
+        // Pre-operational after the boot-up message, as CiA 301 has it:
+        // its first heartbeat changes nothing.
+        assert_eq!(m.state(node(32)), Some(NmtState::PreOperational));
         m.handle_frame(t, &data(0x720, &[0x7F]));
-        m.handle_frame(t, &data(0x720, &[0x7F]));
-        assert_eq!(
-            events(&mut m),
-            [NmtEvent::StateChanged {
-                node: node(32),
-                from: Some(NmtState::BootUp),
-                to: NmtState::PreOperational
-            }]
-        );
+        assert!(events(&mut m).is_empty());
+        // A boot-up from a node seen pre-operational is still reported.
+        m.handle_frame(t, &data(0x720, &[0x00]));
+        assert_eq!(events(&mut m), [NmtEvent::BootUp(node(32))]);
         // A guarding reply with the toggle bit set: 0x85 = operational.
         m.handle_frame(t, &data(0x720, &[0x85]));
         assert_eq!(m.state(node(32)), Some(NmtState::Operational));
@@ -575,7 +577,7 @@ mod tests {
                 NmtEvent::StateChanged {
                     node: node(32),
                     from: Some(NmtState::Operational),
-                    to: NmtState::BootUp
+                    to: NmtState::PreOperational
                 },
                 NmtEvent::BootUp(node(32)),
             ]

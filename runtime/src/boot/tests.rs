@@ -17,18 +17,19 @@ fn plan() -> SlavePlan {
         serial_number: 0,
         software_version: 0,
         configuration_date_time: None,
-        configuration: vec![
+        configuration: Vec::from([
             ConfigWrite {
                 index: 0x1017,
                 sub_index: 0,
-                data: vec![0xE8, 0x03],
+                data: vec![0xE8, 0x03].into(),
             },
             ConfigWrite {
                 index: 0x6060,
                 sub_index: 0,
-                data: vec![1],
+                data: vec![1].into(),
             },
-        ],
+        ])
+        .into(),
         reset: Some(NmtCommand::ResetCommunication),
         heartbeat: true,
         start: true,
@@ -58,7 +59,7 @@ fn a_slave_boots_step_by_step() {
     // Revision and serial number are 0: not read.
     let events = read(&mut boot, 0x1018, 2, 0x1234);
     assert_eq!(events, [BootEvent::IdentityChecked]);
-    for (i, expected) in plan().configuration.into_iter().enumerate() {
+    for (i, expected) in plan().configuration.iter().cloned().enumerate() {
         assert_eq!(boot.poll_request(), Some(Request::Write(expected)));
         let events = boot.write_done(Ok(())).unwrap();
         if i == 1 {
