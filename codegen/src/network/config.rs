@@ -145,6 +145,17 @@ pub fn heartbeat_product(time: u16, multiplier: f64) -> u64 {
     }
 }
 
+/// The consumer time (ms) a master uses for a slave's heartbeat: the
+/// slave's producer time times its `heartbeat_multiplier` (or the bus
+/// options'), as dcfgen computes it; not clamped to 16 bits.
+pub fn consumer_time(bus: &super::model::Bus, node: &Node) -> u64 {
+    let slave = bus.slaves.get(node.slave);
+    let multiplier = slave
+        .and_then(|s| s.heartbeat_multiplier.as_ref())
+        .map_or(bus.options.heartbeat_multiplier, |at| at.value);
+    heartbeat_product(node.heartbeat_producer, multiplier)
+}
+
 /// One entry of a concise DCF.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct ConciseEntry {

@@ -4,6 +4,8 @@
 //! DCFs.
 
 pub mod api;
+mod boot;
+pub use boot::boot_plan;
 pub mod check;
 pub mod config;
 mod configure;

@@ -210,8 +210,8 @@ pub(super) fn master_dcf(
         let entries: Vec<(String, String)> = slaves(bus, configured)
             .filter(|(node, _)| node.heartbeat_producer != 0)
             .enumerate()
-            .map(|(n, (node, slave))| {
-                let time = consumer_heartbeat_time(bus, node, slave, n + 1, &mut differences);
+            .map(|(n, (node, _))| {
+                let time = consumer_heartbeat_time(bus, node, n + 1, &mut differences);
                 (
                     (n + 1).to_string(),
                     hex(u32::from(node.node_id) << 16 | u32::from(time), 8),

@@ -12,7 +12,7 @@ mod pdos;
 use std::fmt;
 
 use super::config::{Configured, Node};
-use super::model::{Bus, SlaveSection};
+use super::model::Bus;
 
 /// One file to write, by its name in the output directory.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -125,15 +125,10 @@ pub fn files(bus: &Bus, configured: &Configured, remote_pdo: bool) -> Written {
 fn consumer_heartbeat_time(
     bus: &Bus,
     node: &Node,
-    slave: &SlaveSection,
     entry: usize,
     differences: &mut Vec<Difference>,
 ) -> u16 {
-    let multiplier = slave
-        .heartbeat_multiplier
-        .as_ref()
-        .map_or(bus.options.heartbeat_multiplier, |at| at.value);
-    let time = heartbeat_product(node.heartbeat_producer, multiplier);
+    let time = super::config::consumer_time(bus, node);
     u16::try_from(time).unwrap_or_else(|_| {
         differences.push(Difference::HeartbeatClamped {
             node: node.name.clone(),
