@@ -24,7 +24,10 @@ mod status;
 use alloc::vec::Vec;
 use core::fmt;
 
-pub use network::{NetworkBoot, NetworkEvent, SlaveState, SlaveStatus, Action, Configuration};
+pub use network::{
+    Action, Configuration, NetworkBoot, NetworkEvent, NetworkReport, SlaveState, SlaveStatus,
+    ends_boot,
+};
 pub use plan::{ConfigWrite, MasterPlan, NetworkPlan, PdoLink, SlaveConfig, SlavePlan, Supervision};
 pub use status::BootStatus;
 

@@ -19,6 +19,7 @@ use super::{
     Error, IDLE_WAIT, Object, RunError, Transfer, Upload, encode, give_up, transfer_end,
     visible_string,
 };
+use crate::boot::{NetworkBoot, NetworkPlan, NetworkReport, ends_boot};
 use crate::master::{self, MasterEvent};
 use crate::nmt::{NmtCommand, NmtTarget};
 use crate::od::{self, Entry, NodeId};
@@ -346,6 +347,29 @@ impl<B: Bus> Master<B> {
                 self.core.handle_frame(self.clock.now(), &frame);
             }
         }
+    }
+
+    /// Boots `plan`'s network ([`master::Master::boot_network`]: every
+    /// slave at once, CiA 302-2) and runs the bus until the boot is decided
+    /// or `deadline` passes ([`Error::DeadlinePassed`]). The boot's events
+    /// stay queued, but for the last; the master supervises the network
+    /// from then on (a slave that resets or returns is booted again while
+    /// the others run).
+    pub fn boot_network(
+        &mut self,
+        plan: NetworkPlan,
+        deadline: impl Into<Deadline>,
+    ) -> Result<NetworkReport, Error> {
+        let now = self.clock.now();
+        self.core.boot_network(now, plan);
+        self.run_until(deadline, |event| match event {
+            MasterEvent::Network(e) if ends_boot(e) => ControlFlow::Break(()),
+            _ => ControlFlow::Continue(()),
+        })?;
+        self.core
+            .network()
+            .and_then(NetworkBoot::report)
+            .ok_or(Error::DeadlinePassed)
     }
 
     /// Sends NMT `cmd` to `target`: one node ([`NmtTarget::Node`]) or,

@@ -117,6 +117,30 @@ pub struct SlaveStatus {
     pub boots: u32,
 }
 
+/// How the network's boot ended, with every slave's report.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct NetworkReport {
+    /// Every mandatory slave is booted (the network runs).
+    pub booted: bool,
+    pub slaves: Vec<SlaveStatus>,
+}
+
+impl NetworkReport {
+    /// The failed boots (mandatory and optional), in node order.
+    pub fn errors(&self) -> impl Iterator<Item = &BootError> {
+        self.slaves.iter().filter_map(|s| s.error.as_ref())
+    }
+}
+
+/// Whether `event` ends the network's first boot ([`NetworkEvent::Booted`]
+/// or [`NetworkEvent::BootFailed`]); what the masters wait for.
+pub fn ends_boot(event: &NetworkEvent) -> bool {
+    matches!(
+        event,
+        NetworkEvent::Booted { .. } | NetworkEvent::BootFailed { .. }
+    )
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Pending {
     Read(u16, u8),
@@ -209,6 +233,15 @@ impl NetworkBoot {
     /// runs.
     pub fn outcome(&self) -> Option<bool> {
         self.decided
+    }
+
+    /// The outcome and every slave's report, once the first boot is
+    /// decided.
+    pub fn report(&self) -> Option<NetworkReport> {
+        Some(NetworkReport {
+            booted: self.decided?,
+            slaves: self.slaves().cloned().collect(),
+        })
     }
 
     /// Starts the boot of every slave at `now` (again, if it ran).

@@ -26,6 +26,7 @@ pub use stream::{Events, PDO_QUEUE_CAPACITY, Pdos};
 use super::Error;
 use crate::CanId;
 use crate::blocking::{Upload, transfer_end};
+use crate::boot::{NetworkBoot, NetworkPlan, NetworkReport, ends_boot};
 use crate::lss::LssEvent;
 use crate::master::{self, MasterEvent};
 use crate::nmt::{NmtCommand, NmtTarget};
@@ -359,6 +360,34 @@ impl Master {
         };
         self.shared.wake.notify_one();
         self.sent(round).await
+    }
+
+    /// Boots `plan`'s network ([`master::Master::boot_network`]: every
+    /// slave at once, CiA 302-2) and returns once the boot is decided. The
+    /// boot's events are published on the [`Events`] streams as any
+    /// others; the master supervises the network from then on. Fails once
+    /// the driver stopped.
+    pub async fn boot_network(&self, plan: NetworkPlan) -> Result<NetworkReport, Error> {
+        let mut events = self.events();
+        {
+            let mut state = self.shared.lock();
+            state.running()?;
+            let now = self.shared.now();
+            state.core.boot_network(now, plan);
+        }
+        self.shared.wake.notify_one();
+        loop {
+            match events.next().await {
+                Some(MasterEvent::Network(e)) if ends_boot(&e) => break,
+                Some(_) => {}
+                None => return Err(self.shared.lock().stopped_error()),
+            }
+        }
+        let state = self.shared.lock();
+        match state.core.network().and_then(NetworkBoot::report) {
+            Some(report) => Ok(report),
+            None => Err(state.stopped_error()),
+        }
     }
 
     /// Returns once the driver sent every frame the cores have ready now.
