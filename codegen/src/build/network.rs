@@ -9,10 +9,10 @@ use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
 use crate::r#gen::rust::network::{self as gen_network, Master, Network, NodeInput, NodePdo};
 use crate::r#gen::rust::{self, Options, check_runtime_path};
 use crate::ir::{Origin, PdoDirection};
-use crate::network::config::Node;
-use crate::network::configure;
+use crate::network::config::{Configured, Node};
 use crate::network::configured::configured_device;
 use crate::network::model::{Bus, SlaveSection};
+use crate::network::{boot_plan, configure};
 
 /// What generating one network produced.
 #[derive(Debug, Clone)]
@@ -64,7 +64,7 @@ pub fn generate_bus(
     if diagnostics.has_errors() {
         return (None, diagnostics);
     }
-    let files = generate_configured(name, bus, &configured.nodes, options, &mut diagnostics);
+    let files = generate_configured(name, bus, &configured, options, &mut diagnostics);
     (files, diagnostics)
 }
 
@@ -99,10 +99,11 @@ fn finish(
 fn generate_configured(
     name: &str,
     bus: &Bus,
-    nodes: &[Node],
+    configured: &Configured,
     options: &Options,
     diagnostics: &mut Diagnostics,
 ) -> Option<Vec<(PathBuf, String)>> {
+    let nodes = &configured.nodes;
     let runtime = match check_runtime_path(&options.runtime_path) {
         Ok(runtime) => runtime,
         Err(problem) => {
@@ -183,6 +184,7 @@ fn generate_configured(
     if diagnostics.has_errors() {
         return None;
     }
+    let plan = boot_plan(bus, configured);
     let network = Network {
         source: &source,
         dir: name,
@@ -194,6 +196,7 @@ fn generate_configured(
             heartbeat_producer_ms: bus.master.heartbeat_producer,
         },
         nodes: inputs,
+        plan: &plan,
     };
     match gen_network::generate(&network, &runtime) {
         Ok(code) => files[0].1 = code,

@@ -28,6 +28,7 @@ mod format;
 mod hazards;
 pub(crate) mod naming;
 pub(crate) mod network;
+mod network_plan;
 mod objects;
 pub(crate) mod od_plan;
 pub(crate) mod pdo;

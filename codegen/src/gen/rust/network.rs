@@ -11,10 +11,12 @@
 use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
+use eds2rust_runtime::boot::NetworkPlan;
+
 use super::docs::{self, Doc};
 use super::naming::{self, Case, Namespace};
 use super::pdo::Emitted;
-use super::{HEADER, RUNTIME_ALIAS, derives, format, prim};
+use super::{HEADER, RUNTIME_ALIAS, derives, format, network_plan, prim};
 use crate::diag::Diagnostics;
 use crate::ir::{Origin, PdoDirection};
 
@@ -27,6 +29,9 @@ pub(crate) struct Network<'a> {
     pub(crate) dir: &'a str,
     pub(crate) master: Master,
     pub(crate) nodes: Vec<NodeInput<'a>>,
+    /// The network's boot plan (`network::boot_plan`), embedded as
+    /// `network::PLAN`.
+    pub(crate) plan: &'a NetworkPlan,
 }
 
 /// The master's settings the generated constants show.
@@ -161,9 +166,11 @@ fn network_module(network: &Network, runtime: &TokenStream, rt: &TokenStream) ->
     let count = Literal::usize_unsuffixed(network.nodes.len());
     let inputs = image(network, PdoDirection::Tpdo, rt);
     let outputs = image(network, PdoDirection::Rpdo, rt);
+    let plan = network_plan::plan_const(network.plan, rt);
     quote! {
-        #[doc = " The network: its nodes, the master's process image and its timing."]
+        #[doc = " The network: its nodes, its boot plan, the master's process image and its timing (with the runtime's `alloc` feature, as the master)."]
         pub mod network {
+            extern crate alloc;
             use #runtime as #rt;
             #[doc = " The bit rate, kbit/s (`master.baudrate`)."]
             pub const BIT_RATE_KBIT: u32 = #bit_rate;
@@ -204,6 +211,7 @@ fn network_module(network: &Network, runtime: &TokenStream, rt: &TokenStream) ->
                     ::core::option::Option::None => panic!("a node id is 1 to 127"),
                 }
             }
+            #plan
             #inputs
             #outputs
         }
@@ -275,6 +283,19 @@ fn image(network: &Network, direction: PdoDirection, rt: &TokenStream) -> TokenS
             let allow = fields
                 .is_empty()
                 .then(|| quote!(#[allow(clippy::match_single_binding)]));
+            // The receiver keeps one slot per identifier: the first input
+            // on it takes it, as in `receive`.
+            let mut ids = std::collections::BTreeSet::new();
+            let latest = fields.iter().filter(|f| ids.insert(f.3.to_string())).map(
+                |(f, ty, _, _)| {
+                    quote! {
+                        if let ::core::option::Option::Some(pdo) = rx.latest::<#ty>(#ty::CAN_ID) {
+                            self.#f = ::core::option::Option::Some(pdo?);
+                        }
+                    }
+                },
+            );
+            let rx_unused = fields.is_empty().then(|| quote!(let _ = rx;));
             let mut derive_list = derives::names(derives::PDO, float);
             derive_list.push("Default");
             let derive_idents = derive_list.iter().map(|d| naming::ident(d));
@@ -302,6 +323,12 @@ fn image(network: &Network, direction: PdoDirection, rt: &TokenStream) -> TokenS
                             _ => ::core::result::Result::Ok(false),
                         }
                     }
+                    #[doc = " Takes the last data the master's PDO receiver holds for each input (`master.pdo_rx` of a `Master::for_network(&PLAN)`, which watches every input): a field is updated once its PDO was received; the others keep their value. A length that is not the PDO's is an error. Never panics."]
+                    pub fn take_latest<const N: usize>(&mut self, rx: &#rt::pdo::PdoReceiver<N>) -> ::core::result::Result<(), #rt::od::PdoLengthError> {
+                        #rx_unused
+                        #(#latest)*
+                        ::core::result::Result::Ok(())
+                    }
                 }
             }
         }
@@ -316,6 +343,10 @@ fn image(network: &Network, direction: PdoDirection, rt: &TokenStream) -> TokenS
                     #rt::Frame::with_id(#id, data, len as u8)
                 }}
             });
+            let sets = fields
+                .iter()
+                .map(|(f, ty, _, _)| quote!(master.set_pdo(now, #ty::COB_ID, &self.#f)?;));
+            let unused = fields.is_empty().then(|| quote!(let _ = (master, now);));
             let derives = derives::attr(derives::PDO, float);
             quote! {
                 #[doc = " What the master sends: each slave RPDO."]
@@ -329,6 +360,12 @@ fn image(network: &Network, direction: PdoDirection, rt: &TokenStream) -> TokenS
                     #[doc = " The frames of every output, in the order of the fields."]
                     pub fn frames(&self) -> [#rt::Frame; #count] {
                         [#(#frames),*]
+                    }
+                    #[doc = " Sets every output as the data of its RPDO on the master (`Master::set_pdo` with the PDO's COB-ID; `Master::for_network(&PLAN)` set up each one's transmitter): a synchronous one goes out after the next SYNC, an event-driven one at once (after its inhibit time)."]
+                    pub fn set_pdos(&self, master: &mut #rt::master::Master, now: #rt::Instant) -> ::core::result::Result<(), #rt::pdo::PdoError> {
+                        #unused
+                        #(#sets)*
+                        ::core::result::Result::Ok(())
                     }
                 }
             }
@@ -399,6 +436,24 @@ mod tests {
     }
 
     fn network(nodes: Vec<NodeInput<'_>>) -> String {
+        let plan = NetworkPlan {
+            master: eds2rust_runtime::boot::MasterPlan {
+                node: eds2rust_runtime::od::NodeId::new(1).expect("a node id"),
+                heartbeat: None,
+                sync_period: None,
+                sync_overflow: 0,
+            },
+            slaves: Vec::new().into(),
+            boot_time: None,
+            response_time: NetworkPlan::DEFAULT_RESPONSE_TIME,
+            start_nodes: true,
+            start_all_nodes: false,
+            start_master: true,
+            reset_all_nodes: false,
+            stop_all_nodes: false,
+            receive: Vec::new().into(),
+            transmit: Vec::new().into(),
+        };
         let network = Network {
             source: "bus.yml",
             dir: "net",
@@ -410,6 +465,7 @@ mod tests {
                 heartbeat_producer_ms: 0,
             },
             nodes,
+            plan: &plan,
         };
         generate(&network, &quote!(::eds2rust_runtime)).expect("valid Rust")
     }

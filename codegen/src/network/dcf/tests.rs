@@ -7,7 +7,7 @@ use super::*;
 use crate::ir::pdo::MappedObject;
 use crate::ir::{Access, DataType, Device, Entry, Literal, Object, ObjectKind, Origin, Value};
 use crate::network::config::{ConciseEntry, Pdo};
-use crate::network::model::{At, BusOptions, MasterSection, Spot};
+use crate::network::model::{At, BusOptions, MasterSection, SlaveSection, Spot};
 
 fn entry(sub: u8, name: &str, data_type: DataType, default: Option<i128>) -> Entry {
     Entry {

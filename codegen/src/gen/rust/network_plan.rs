@@ -1,0 +1,303 @@
+//! The generated network's boot plan: the constant `network::PLAN`, a
+//! [`NetworkPlan`] written out as a Rust expression. The value comes from
+//! `network::boot_plan` (the one conversion of a configured bus file into
+//! a plan); this file only renders it, every list as `Cow::Borrowed` of a
+//! slice so that the plan is a `const`.
+
+use std::time::Duration;
+
+use eds2rust_runtime::boot::{
+    ConfigWrite, MasterPlan, NetworkPlan, PdoLink, SlaveConfig, SlavePlan, Supervision,
+};
+use eds2rust_runtime::nmt::NmtCommand;
+use eds2rust_runtime::od::NodeId;
+use proc_macro2::{Literal, TokenStream};
+use quote::{ToTokens, quote};
+
+use super::prim;
+
+/// `pub const PLAN: rt::boot::NetworkPlan = ..;` with its documentation,
+/// for the `network` module (which names the runtime `rt` and declares
+/// `extern crate alloc`).
+pub(crate) fn plan_const(plan: &NetworkPlan, rt: &TokenStream) -> TokenStream {
+    let value = network(plan, rt);
+    let writes = plan.slaves.iter().any(|s| !s.plan.configuration.is_empty());
+    let helper = writes.then(|| {
+        quote! {
+            #[doc = " One entry of a slave's configuration in [`PLAN`]."]
+        const fn write(index: u16, sub_index: u8, data: &'static [u8]) -> #rt::boot::ConfigWrite {
+            #rt::boot::ConfigWrite {
+                index,
+                sub_index,
+                data: alloc::borrow::Cow::Borrowed(data),
+            }
+        }
+        }
+    });
+    quote! {
+        #helper
+        #[doc = " The network's boot plan (CiA 302-2): what the master checks, configures and starts on each slave, how it supervises them, and the PDOs it sends and receives. The same value as `eds2rust::network::boot_plan` of the bus file; give it to `Master::for_network` and `boot_network`."]
+        pub const PLAN: #rt::boot::NetworkPlan = #value;
+    }
+}
+
+fn network(plan: &NetworkPlan, rt: &TokenStream) -> TokenStream {
+    let NetworkPlan {
+        master,
+        slaves,
+        boot_time,
+        response_time,
+        start_nodes,
+        start_all_nodes,
+        start_master,
+        reset_all_nodes,
+        stop_all_nodes,
+        receive,
+        transmit,
+    } = plan;
+    let master = master_plan(master, rt);
+    let slaves = borrowed(slaves.iter().map(|s| slave(s, rt)));
+    let boot_time = option(boot_time.map(duration));
+    let response_time = duration(*response_time);
+    let receive = borrowed(receive.iter().map(|l| link(l, rt)));
+    let transmit = borrowed(transmit.iter().map(|l| link(l, rt)));
+    quote! {
+        #rt::boot::NetworkPlan {
+            master: #master,
+            slaves: #slaves,
+            boot_time: #boot_time,
+            response_time: #response_time,
+            start_nodes: #start_nodes,
+            start_all_nodes: #start_all_nodes,
+            start_master: #start_master,
+            reset_all_nodes: #reset_all_nodes,
+            stop_all_nodes: #stop_all_nodes,
+            receive: #receive,
+            transmit: #transmit,
+        }
+    }
+}
+
+fn master_plan(master: &MasterPlan, rt: &TokenStream) -> TokenStream {
+    let MasterPlan {
+        node,
+        heartbeat,
+        sync_period,
+        sync_overflow,
+    } = master;
+    let node = node_id(*node);
+    let heartbeat = option(heartbeat.map(duration));
+    let sync_period = option(sync_period.map(duration));
+    let sync_overflow = Literal::u8_unsuffixed(*sync_overflow);
+    quote! {
+        #rt::boot::MasterPlan {
+            node: #node,
+            heartbeat: #heartbeat,
+            sync_period: #sync_period,
+            sync_overflow: #sync_overflow,
+        }
+    }
+}
+
+fn slave(slave: &SlaveConfig, rt: &TokenStream) -> TokenStream {
+    let SlaveConfig {
+        name,
+        plan,
+        boot,
+        mandatory,
+        supervision,
+    } = slave;
+    let name: &str = name;
+    let plan = slave_plan(plan, rt);
+    let supervision = match supervision {
+        Supervision::None => quote!(#rt::boot::Supervision::None),
+        Supervision::Heartbeat(time) => {
+            let time = duration(*time);
+            quote!(#rt::boot::Supervision::Heartbeat(#time))
+        }
+        Supervision::Guarding {
+            guard_time,
+            life_time_factor,
+        } => {
+            let guard_time = duration(*guard_time);
+            let factor = Literal::u8_unsuffixed(life_time_factor.get());
+            quote! {
+                #rt::boot::Supervision::Guarding {
+                    guard_time: #guard_time,
+                    life_time_factor: match ::core::num::NonZeroU8::new(#factor) {
+                        ::core::option::Option::Some(factor) => factor,
+                        ::core::option::Option::None => panic!("a life time factor is 1 to 255"),
+                    },
+                }
+            }
+        }
+    };
+    quote! {
+        #rt::boot::SlaveConfig {
+            name: alloc::borrow::Cow::Borrowed(#name),
+            plan: #plan,
+            boot: #boot,
+            mandatory: #mandatory,
+            supervision: #supervision,
+        }
+    }
+}
+
+fn slave_plan(plan: &SlavePlan, rt: &TokenStream) -> TokenStream {
+    let SlavePlan {
+        node,
+        device_type,
+        vendor_id,
+        product_code,
+        revision_number,
+        serial_number,
+        software_version,
+        configuration_date_time,
+        configuration,
+        reset,
+        heartbeat,
+        start,
+    } = plan;
+    let node = node_id(*node);
+    let [
+        device_type,
+        vendor_id,
+        product_code,
+        revision_number,
+        serial_number,
+        software_version,
+    ] = [
+        device_type,
+        vendor_id,
+        product_code,
+        revision_number,
+        serial_number,
+        software_version,
+    ]
+    .map(|v| hex(*v));
+    let date_time = option(configuration_date_time.map(|(date, time)| {
+        let (date, time) = (hex(date), hex(time));
+        quote!((#date, #time))
+    }));
+    let configuration = borrowed(configuration.iter().map(write));
+    let reset = option(reset.map(|cmd| {
+        let cmd = nmt_command(cmd);
+        quote!(#rt::nmt::NmtCommand::#cmd)
+    }));
+    quote! {
+        #rt::boot::SlavePlan {
+            node: #node,
+            device_type: #device_type,
+            vendor_id: #vendor_id,
+            product_code: #product_code,
+            revision_number: #revision_number,
+            serial_number: #serial_number,
+            software_version: #software_version,
+            configuration_date_time: #date_time,
+            configuration: #configuration,
+            reset: #reset,
+            heartbeat: #heartbeat,
+            start: #start,
+        }
+    }
+}
+
+fn write(write: &ConfigWrite) -> TokenStream {
+    let ConfigWrite {
+        index,
+        sub_index,
+        data,
+    } = write;
+    let index = hex(u32::from(*index));
+    let sub_index = Literal::u8_unsuffixed(*sub_index);
+    let data = data.iter().map(|b| byte(*b));
+    quote!(write(#index, #sub_index, &[#(#data),*]))
+}
+
+fn link(link: &PdoLink, rt: &TokenStream) -> TokenStream {
+    let PdoLink {
+        node,
+        number,
+        cob_id,
+        transmission,
+        len,
+        event_timer,
+        inhibit_time,
+    } = link;
+    let node = node_id(*node);
+    let number = Literal::u16_unsuffixed(*number);
+    let cob_id = hex(*cob_id);
+    let transmission = Literal::u8_unsuffixed(*transmission);
+    let len = Literal::u8_unsuffixed(*len);
+    let event_timer = Literal::u16_unsuffixed(*event_timer);
+    let inhibit_time = Literal::u16_unsuffixed(*inhibit_time);
+    quote! {
+        #rt::boot::PdoLink {
+            node: #node,
+            number: #number,
+            cob_id: #cob_id,
+            transmission: #transmission,
+            len: #len,
+            event_timer: #event_timer,
+            inhibit_time: #inhibit_time,
+        }
+    }
+}
+
+/// The variant name of `cmd` (every command a plan may hold).
+fn nmt_command(cmd: NmtCommand) -> TokenStream {
+    match cmd {
+        NmtCommand::Start => quote!(Start),
+        NmtCommand::Stop => quote!(Stop),
+        NmtCommand::EnterPreOperational => quote!(EnterPreOperational),
+        NmtCommand::ResetNode => quote!(ResetNode),
+        NmtCommand::ResetCommunication => quote!(ResetCommunication),
+    }
+}
+
+/// A node id through the `network` module's `node_id` (a const check).
+fn node_id(node: NodeId) -> TokenStream {
+    let id = Literal::u8_unsuffixed(node.get());
+    quote!(node_id(#id))
+}
+
+/// A duration in its largest whole unit.
+fn duration(d: Duration) -> TokenStream {
+    let nanos = d.as_nanos();
+    let (unit, value) = if nanos % 1_000_000_000 == 0 {
+        (quote!(from_secs), nanos / 1_000_000_000)
+    } else if nanos % 1_000_000 == 0 {
+        (quote!(from_millis), nanos / 1_000_000)
+    } else if nanos % 1_000 == 0 {
+        (quote!(from_micros), nanos / 1_000)
+    } else {
+        (quote!(from_nanos), nanos)
+    };
+    // Every unit takes a u64; a plan's durations are far below its limit.
+    let value = Literal::u64_unsuffixed(u64::try_from(value).unwrap_or(u64::MAX));
+    quote!(::core::time::Duration::#unit(#value))
+}
+
+fn option(value: Option<TokenStream>) -> TokenStream {
+    match value {
+        Some(v) => quote!(::core::option::Option::Some(#v)),
+        None => quote!(::core::option::Option::None),
+    }
+}
+
+/// A byte as two hex digits (`0x0F`).
+fn byte(b: u8) -> TokenStream {
+    format!("0x{b:02X}")
+        .parse()
+        .unwrap_or_else(|_| Literal::u8_unsuffixed(b).into_token_stream())
+}
+
+fn hex(v: u32) -> TokenStream {
+    prim::hex(u128::from(v))
+}
+
+/// `Cow::Borrowed(&[..])` of `items`.
+fn borrowed(items: impl Iterator<Item = TokenStream>) -> TokenStream {
+    let items: Vec<_> = items.collect();
+    quote!(alloc::borrow::Cow::Borrowed(&[#(#items),*]))
+}
