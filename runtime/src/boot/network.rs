@@ -289,6 +289,16 @@ impl NetworkBoot {
             booting && slave.boot.as_ref().is_some_and(SlaveBoot::awaits_heartbeat);
         let without_reset = slave.config.plan.reset.is_none() || self.plan.reset_all_nodes;
         let lost = slave.status.state == SlaveState::Lost;
+        // A boot-up while the read of 0x1000 that follows a boot-up is in
+        // flight: the boot it starts would send that read again (two
+        // boot-ups in a row: one already on its way when the boot started,
+        // then the one of the reset the master asked for). Replacing the
+        // transfer would take the node's answer to the first read as the
+        // answer to the second and fail on the next.
+        let reading_device_type = booting && slave.pending == Some(Pending::Read(0x1000, 0));
+        if state == NmtState::BootUp && reading_device_type {
+            return;
+        }
         if state == NmtState::BootUp {
             if !awaiting_boot_up {
                 // It reset by itself: everything it was told is gone.
@@ -454,7 +464,10 @@ impl NetworkBoot {
     /// Hands out the requests of every running boot.
     fn drive(&mut self, now: Instant) {
         for i in 0..self.slaves.len() {
-            while let Some(request) = self.slaves[i].boot.as_mut().and_then(SlaveBoot::poll_request)
+            while let Some(request) = self.slaves[i]
+                .boot
+                .as_mut()
+                .and_then(SlaveBoot::poll_request)
             {
                 let slave = &mut self.slaves[i];
                 let node = slave.status.node;
@@ -466,10 +479,12 @@ impl NetworkBoot {
                         self.events.push_back(NetworkEvent::Started(node));
                     }
                     Request::Nmt(cmd) => {
-                        self.actions.push_back(Action::Nmt(cmd, NmtTarget::Node(node)));
+                        self.actions
+                            .push_back(Action::Nmt(cmd, NmtTarget::Node(node)));
                     }
                     Request::AwaitBootUp => {
-                        slave.wait_until = Some(wait_end(&self.plan, self.deadline, slave.first, now));
+                        slave.wait_until =
+                            Some(wait_end(&self.plan, self.deadline, slave.first, now));
                     }
                     Request::AwaitHeartbeat => {
                         let time = match slave.config.supervision {
@@ -515,10 +530,7 @@ impl NetworkBoot {
             let done = step == BootEvent::Booted;
             self.events.push_back(NetworkEvent::Step { node, step });
             if done {
-                let start = self.slaves[i]
-                    .boot
-                    .as_ref()
-                    .is_some_and(|b| b.plan().start);
+                let start = self.slaves[i].boot.as_ref().is_some_and(|b| b.plan().start);
                 self.booted(now, i, start);
             }
         }
@@ -629,3 +641,6 @@ fn wait_end(plan: &NetworkPlan, deadline: Option<Instant>, first: bool, now: Ins
         _ => now + plan.response_time,
     }
 }
+
+#[cfg(test)]
+mod tests;
