@@ -146,6 +146,27 @@ impl Bus for MasterPort {
     }
 }
 
+/// Where the harness attaches simulated devices.
+#[derive(Debug)]
+enum DevicePorts {
+    /// No simulator runs (a real device on a SocketCAN interface).
+    None,
+    /// The in-process virtual bus.
+    Virtual(VirtualBus),
+    /// A SocketCAN interface, opened once per device.
+    #[cfg(all(feature = "socketcan", target_os = "linux"))]
+    SocketCan(String),
+}
+
+/// A port on the SocketCAN interface `name`.
+#[cfg(all(feature = "socketcan", target_os = "linux"))]
+fn open_socketcan(name: &str) -> io::Result<MasterPort> {
+    use eds2rust_runtime::transport::socketcan::SocketCanBus;
+    SocketCanBus::open(name)
+        .map(MasterPort::SocketCan)
+        .map_err(|e| io::Error::new(e.kind(), format!("SocketCAN interface `{name}`: {e}")))
+}
+
 /// Lines shared between the threads.
 type Lines = Arc<Mutex<Vec<String>>>;
 
@@ -160,6 +181,8 @@ fn push(lines: &Lines, line: String) {
 #[derive(Debug)]
 pub struct Harness {
     clock: Clock,
+    /// Where more simulated devices join ([`Harness::add_device`]).
+    devices: DevicePorts,
     port: Option<MasterPort>,
     stop: Arc<AtomicBool>,
     threads: Vec<JoinHandle<io::Result<()>>>,
@@ -182,6 +205,7 @@ impl Harness {
         let clock = Clock::new();
         let mut harness = Harness {
             clock: clock.clone(),
+            devices: DevicePorts::None,
             port: None,
             stop: Arc::new(AtomicBool::new(false)),
             threads: Vec::new(),
@@ -193,21 +217,14 @@ impl Harness {
                 let bus = VirtualBus::new();
                 harness.port = Some(MasterPort::Virtual(bus.attach()));
                 harness.spawn_tracer(MasterPort::Virtual(bus.attach()), args.trace);
-                harness.spawn_device(MasterPort::Virtual(bus.attach()), device(clock.now()))?;
+                harness.devices = DevicePorts::Virtual(bus);
             }
             #[cfg(all(feature = "socketcan", target_os = "linux"))]
             Some(name) => {
-                use eds2rust_runtime::transport::socketcan::SocketCanBus;
-                let open = |name: &str| {
-                    SocketCanBus::open(name).map_err(|e| {
-                        io::Error::new(e.kind(), format!("SocketCAN interface `{name}`: {e}"))
-                    })
-                };
-                harness.port = Some(MasterPort::SocketCan(open(name)?));
-                harness.spawn_tracer(MasterPort::SocketCan(open(name)?), args.trace);
+                harness.port = Some(open_socketcan(name)?);
+                harness.spawn_tracer(open_socketcan(name)?, args.trace);
                 if args.simulate {
-                    harness
-                        .spawn_device(MasterPort::SocketCan(open(name)?), device(clock.now()))?;
+                    harness.devices = DevicePorts::SocketCan(name.clone());
                 }
             }
             #[cfg(all(feature = "socketcan", not(target_os = "linux")))]
@@ -228,7 +245,27 @@ impl Harness {
                 ));
             }
         }
+        harness.add_device(device)?;
         Ok(harness)
+    }
+
+    /// Starts one more simulated device on the same bus (given the
+    /// power-on time), in a thread of its own, when a simulator runs
+    /// ([`Args::simulates`]); otherwise the real device is expected on the
+    /// bus and `device` is not called.
+    pub fn add_device<B, F>(&mut self, device: F) -> io::Result<()>
+    where
+        B: Behaviour + Send + 'static,
+        B::Event: Send,
+        F: FnOnce(Instant) -> Device<B>,
+    {
+        let port = match &self.devices {
+            DevicePorts::None => return Ok(()),
+            DevicePorts::Virtual(bus) => MasterPort::Virtual(bus.attach()),
+            #[cfg(all(feature = "socketcan", target_os = "linux"))]
+            DevicePorts::SocketCan(name) => open_socketcan(name)?,
+        };
+        self.spawn_device(port, device(self.clock.now()))
     }
 
     fn spawn_tracer(&mut self, mut port: MasterPort, print: bool) {

@@ -264,11 +264,11 @@ fn node_id(node: NodeId) -> TokenStream {
 /// A duration in its largest whole unit.
 fn duration(d: Duration) -> TokenStream {
     let nanos = d.as_nanos();
-    let (unit, value) = if nanos % 1_000_000_000 == 0 {
+    let (unit, value) = if nanos.is_multiple_of(1_000_000_000) {
         (quote!(from_secs), nanos / 1_000_000_000)
-    } else if nanos % 1_000_000 == 0 {
+    } else if nanos.is_multiple_of(1_000_000) {
         (quote!(from_millis), nanos / 1_000_000)
-    } else if nanos % 1_000 == 0 {
+    } else if nanos.is_multiple_of(1_000) {
         (quote!(from_micros), nanos / 1_000)
     } else {
         (quote!(from_nanos), nanos)
@@ -300,4 +300,102 @@ fn hex(v: u32) -> TokenStream {
 fn borrowed(items: impl Iterator<Item = TokenStream>) -> TokenStream {
     let items: Vec<_> = items.collect();
     quote!(alloc::borrow::Cow::Borrowed(&[#(#items),*]))
+}
+
+#[cfg(test)]
+mod tests {
+    use std::num::NonZeroU8;
+
+    use super::*;
+
+    fn text(tokens: TokenStream) -> String {
+        tokens.to_string().replace(' ', "")
+    }
+
+    #[test]
+    fn durations_take_their_largest_whole_unit() {
+        let cases = [
+            (
+                Duration::from_secs(2),
+                "::core::time::Duration::from_secs(2)",
+            ),
+            (
+                Duration::from_millis(300),
+                "::core::time::Duration::from_millis(300)",
+            ),
+            (
+                Duration::from_micros(1500),
+                "::core::time::Duration::from_micros(1500)",
+            ),
+            (
+                Duration::from_nanos(7),
+                "::core::time::Duration::from_nanos(7)",
+            ),
+            (Duration::ZERO, "::core::time::Duration::from_secs(0)"),
+        ];
+        for (d, expected) in cases {
+            assert_eq!(text(duration(d)), expected, "{d:?}");
+        }
+    }
+
+    #[test]
+    fn a_guarded_slave_without_configuration_needs_no_write_helper() {
+        let node = NodeId::new(3).expect("a node id");
+        let plan = NetworkPlan {
+            master: MasterPlan {
+                node,
+                heartbeat: None,
+                sync_period: None,
+                sync_overflow: 0,
+            },
+            slaves: vec![SlaveConfig {
+                name: "drive".into(),
+                plan: SlavePlan {
+                    node,
+                    device_type: 0x0002_0192,
+                    vendor_id: 0,
+                    product_code: 0,
+                    revision_number: 0,
+                    serial_number: 0,
+                    software_version: 0,
+                    configuration_date_time: Some((1, 2)),
+                    configuration: Vec::new().into(),
+                    reset: Some(NmtCommand::ResetNode),
+                    heartbeat: false,
+                    start: false,
+                },
+                boot: true,
+                mandatory: true,
+                supervision: Supervision::Guarding {
+                    guard_time: Duration::from_millis(100),
+                    life_time_factor: NonZeroU8::new(3).expect("not zero"),
+                },
+            }]
+            .into(),
+            boot_time: Some(Duration::from_secs(5)),
+            response_time: NetworkPlan::DEFAULT_RESPONSE_TIME,
+            start_nodes: true,
+            start_all_nodes: true,
+            start_master: true,
+            reset_all_nodes: false,
+            stop_all_nodes: true,
+            receive: Vec::new().into(),
+            transmit: Vec::new().into(),
+        };
+        let code = text(plan_const(&plan, &quote!(rt)));
+        assert!(!code.contains("constfnwrite"), "{code}");
+        assert!(
+            code.contains("life_time_factor:match::core::num::NonZeroU8::new(3)"),
+            "{code}"
+        );
+        assert!(
+            code.contains("reset:::core::option::Option::Some(rt::nmt::NmtCommand::ResetNode)"),
+            "{code}"
+        );
+        assert!(
+            code.contains("configuration_date_time:::core::option::Option::Some((0x1,0x2))"),
+            "{code}"
+        );
+        assert!(code.contains("device_type:0x020192"), "{code}");
+    }
 }
