@@ -12,8 +12,9 @@
 //!   streamed by block download to the corpus bootloader slave, simulated
 //!   (not run without ../shared: it reads the DCF);
 //! - downstream/machine: the three seed devices as one machine, the typed
-//!   network of eds/machine/bus.yml generated in its build script, its
-//!   process image run on the virtual bus.
+//!   network of eds/machine/bus.yml generated in its build script, booted
+//!   from its generated plan against simulated devices, its process image
+//!   run on the virtual bus.
 
 use std::path::Path;
 use std::process::Command;
@@ -180,15 +181,19 @@ fn api_lock_matches_its_committed_snapshot() {
 }
 
 /// The typed network of the seed machine builds (strict: the bus file gives
-/// no warning) and its process image works on the virtual bus.
+/// no warning), its plan is `boot_plan` of the bus file, the master boots
+/// the network from it and its process image works on the virtual bus.
 #[test]
 fn machine_generates_its_network_and_runs_its_process_image() {
     let dir = workspace_root().join("downstream/machine");
     assert!(dir.join("Cargo.lock").is_file(), "a lock file of its own");
     let output = cargo("machine", &["test"]);
-    assert!(
-        output.contains("one_sync_cycle_on_the_virtual_bus ... ok"),
-        "{output}"
-    );
+    for test in [
+        "one_sync_cycle_on_the_virtual_bus",
+        "the_plan_is_boot_plan_of_the_bus_file",
+        "the_machine_boots_from_its_plan_and_exchanges_its_process_image",
+    ] {
+        assert!(output.contains(&format!("{test} ... ok")), "{test}\n{output}");
+    }
     assert!(!output.contains("test result: FAILED"), "{output}");
 }
