@@ -193,7 +193,10 @@ fn machine_generates_its_network_and_runs_its_process_image() {
         "the_plan_is_boot_plan_of_the_bus_file",
         "the_machine_boots_from_its_plan_and_exchanges_its_process_image",
     ] {
-        assert!(output.contains(&format!("{test} ... ok")), "{test}\n{output}");
+        assert!(
+            output.contains(&format!("{test} ... ok")),
+            "{test}\n{output}"
+        );
     }
     assert!(!output.contains("test result: FAILED"), "{output}");
 }
