@@ -111,6 +111,12 @@ fn the_machine_boots_from_its_plan_and_exchanges_its_process_image() {
     // bytes), not the device's default: it decodes.
     assert!(cell.inputs.axis_tpdo2.is_some(), "{:?}", cell.inputs);
     assert!(cell.inputs.conveyor_tpdo4.is_some(), "{:?}", cell.inputs);
+    // The blocking master's PDO calls take the generated structs and
+    // their network COB-IDs too.
+    let tpdo2 = m
+        .latest_pdo_on::<axis::pdo::Tpdo2>(axis::pdo::Tpdo2::COB_ID)
+        .expect("watched with its length");
+    assert_eq!(tpdo2, cell.inputs.axis_tpdo2);
     // The synchronous RPDO reached the axis's object dictionary.
     let target = m
         .read::<axis::od::TargetPosition>(node(axis::NODE_ID))

@@ -436,24 +436,7 @@ mod tests {
     }
 
     fn network(nodes: Vec<NodeInput<'_>>) -> String {
-        let plan = NetworkPlan {
-            master: eds2rust_runtime::boot::MasterPlan {
-                node: eds2rust_runtime::od::NodeId::new(1).expect("a node id"),
-                heartbeat: None,
-                sync_period: None,
-                sync_overflow: 0,
-            },
-            slaves: Vec::new().into(),
-            boot_time: None,
-            response_time: NetworkPlan::DEFAULT_RESPONSE_TIME,
-            start_nodes: true,
-            start_all_nodes: false,
-            start_master: true,
-            reset_all_nodes: false,
-            stop_all_nodes: false,
-            receive: Vec::new().into(),
-            transmit: Vec::new().into(),
-        };
+        let plan = super::network_plan::test_plan(Vec::new());
         let network = Network {
             source: "bus.yml",
             dir: "net",

@@ -302,6 +302,29 @@ fn borrowed(items: impl Iterator<Item = TokenStream>) -> TokenStream {
     quote!(alloc::borrow::Cow::Borrowed(&[#(#items),*]))
 }
 
+/// A plan of master node 1 with `slaves` and nothing else, for tests.
+#[cfg(test)]
+pub(crate) fn test_plan(slaves: Vec<SlaveConfig>) -> NetworkPlan {
+    NetworkPlan {
+        master: MasterPlan {
+            node: NodeId::new(1).expect("a node id"),
+            heartbeat: None,
+            sync_period: None,
+            sync_overflow: 0,
+        },
+        slaves: slaves.into(),
+        boot_time: None,
+        response_time: NetworkPlan::DEFAULT_RESPONSE_TIME,
+        start_nodes: true,
+        start_all_nodes: false,
+        start_master: true,
+        reset_all_nodes: false,
+        stop_all_nodes: false,
+        receive: Vec::new().into(),
+        transmit: Vec::new().into(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use std::num::NonZeroU8;
@@ -341,47 +364,32 @@ mod tests {
     #[test]
     fn a_guarded_slave_without_configuration_needs_no_write_helper() {
         let node = NodeId::new(3).expect("a node id");
-        let plan = NetworkPlan {
-            master: MasterPlan {
+        let mut plan = test_plan(vec![SlaveConfig {
+            name: "drive".into(),
+            plan: SlavePlan {
                 node,
-                heartbeat: None,
-                sync_period: None,
-                sync_overflow: 0,
+                device_type: 0x0002_0192,
+                vendor_id: 0,
+                product_code: 0,
+                revision_number: 0,
+                serial_number: 0,
+                software_version: 0,
+                configuration_date_time: Some((1, 2)),
+                configuration: Vec::new().into(),
+                reset: Some(NmtCommand::ResetNode),
+                heartbeat: false,
+                start: false,
             },
-            slaves: vec![SlaveConfig {
-                name: "drive".into(),
-                plan: SlavePlan {
-                    node,
-                    device_type: 0x0002_0192,
-                    vendor_id: 0,
-                    product_code: 0,
-                    revision_number: 0,
-                    serial_number: 0,
-                    software_version: 0,
-                    configuration_date_time: Some((1, 2)),
-                    configuration: Vec::new().into(),
-                    reset: Some(NmtCommand::ResetNode),
-                    heartbeat: false,
-                    start: false,
-                },
-                boot: true,
-                mandatory: true,
-                supervision: Supervision::Guarding {
-                    guard_time: Duration::from_millis(100),
-                    life_time_factor: NonZeroU8::new(3).expect("not zero"),
-                },
-            }]
-            .into(),
-            boot_time: Some(Duration::from_secs(5)),
-            response_time: NetworkPlan::DEFAULT_RESPONSE_TIME,
-            start_nodes: true,
-            start_all_nodes: true,
-            start_master: true,
-            reset_all_nodes: false,
-            stop_all_nodes: true,
-            receive: Vec::new().into(),
-            transmit: Vec::new().into(),
-        };
+            boot: true,
+            mandatory: true,
+            supervision: Supervision::Guarding {
+                guard_time: Duration::from_millis(100),
+                life_time_factor: NonZeroU8::new(3).expect("not zero"),
+            },
+        }]);
+        plan.boot_time = Some(Duration::from_secs(5));
+        plan.start_all_nodes = true;
+        plan.stop_all_nodes = true;
         let code = text(plan_const(&plan, &quote!(rt)));
         assert!(!code.contains("constfnwrite"), "{code}");
         assert!(
