@@ -37,7 +37,7 @@ pub mod example {
 /// Zimmer axis (node 40), the LINAK actuator (32) and the Interroll
 /// conveyor (5) on one bus, each node's module with the PDOs the network
 /// configures, and `network` with the process image and the boot plan
-/// `network::PLAN`.
+/// `network::PLAN` (the master's types: the runtime's `alloc` feature).
 #[cfg(feature = "machine")]
 pub mod machine {
     include!(concat!(env!("OUT_DIR"), "/machine.rs"));

@@ -5,8 +5,10 @@
 //! `build.rs` generates [`machine`] from the bus file: one module per node
 //! with its typed object dictionary and the PDOs the network configures
 //! (`machine::axis::pdo::Rpdo1ControlAndTargetPosition`, ...), and
-//! `machine::network` with the nodes, the master's process image
-//! ([`Inputs`], [`Outputs`]) and the timing constants. [`Cell`] is the
+//! `machine::network` with the nodes, the boot plan
+//! (`machine::network::PLAN`, for `Master::for_network` and
+//! `boot_network`), the master's process image ([`Inputs`], [`Outputs`])
+//! and the timing constants. [`Cell`] is the
 //! master's side of one SYNC cycle written against that image.
 #![forbid(unsafe_code)]
 
