@@ -28,7 +28,9 @@ pub use network::{
     Action, Configuration, NetworkBoot, NetworkEvent, NetworkReport, SlaveState, SlaveStatus,
     ends_boot,
 };
-pub use plan::{ConfigWrite, MasterPlan, NetworkPlan, PdoLink, SlaveConfig, SlavePlan, Supervision};
+pub use plan::{
+    ConfigWrite, MasterPlan, NetworkPlan, PdoLink, SlaveConfig, SlavePlan, Supervision,
+};
 pub use status::BootStatus;
 
 use crate::nmt::{NmtCommand, NmtState};

@@ -454,7 +454,10 @@ impl NetworkBoot {
     /// Hands out the requests of every running boot.
     fn drive(&mut self, now: Instant) {
         for i in 0..self.slaves.len() {
-            while let Some(request) = self.slaves[i].boot.as_mut().and_then(SlaveBoot::poll_request)
+            while let Some(request) = self.slaves[i]
+                .boot
+                .as_mut()
+                .and_then(SlaveBoot::poll_request)
             {
                 let slave = &mut self.slaves[i];
                 let node = slave.status.node;
@@ -466,10 +469,12 @@ impl NetworkBoot {
                         self.events.push_back(NetworkEvent::Started(node));
                     }
                     Request::Nmt(cmd) => {
-                        self.actions.push_back(Action::Nmt(cmd, NmtTarget::Node(node)));
+                        self.actions
+                            .push_back(Action::Nmt(cmd, NmtTarget::Node(node)));
                     }
                     Request::AwaitBootUp => {
-                        slave.wait_until = Some(wait_end(&self.plan, self.deadline, slave.first, now));
+                        slave.wait_until =
+                            Some(wait_end(&self.plan, self.deadline, slave.first, now));
                     }
                     Request::AwaitHeartbeat => {
                         let time = match slave.config.supervision {
@@ -515,10 +520,7 @@ impl NetworkBoot {
             let done = step == BootEvent::Booted;
             self.events.push_back(NetworkEvent::Step { node, step });
             if done {
-                let start = self.slaves[i]
-                    .boot
-                    .as_ref()
-                    .is_some_and(|b| b.plan().start);
+                let start = self.slaves[i].boot.as_ref().is_some_and(|b| b.plan().start);
                 self.booted(now, i, start);
             }
         }
