@@ -1,5 +1,7 @@
 //! `eds2rust monitor`: a live SocketCAN bus through the decoder of
-//! `eds2rust decode` (the `eds2rust-decode` library): the record stream as
+//! `eds2rust decode` (the `eds2rust-decode` library), the nodes' files
+//! given one by one (`--node N=FILE`) or by a bus file (`--bus bus.yml`:
+//! the PDOs as the network configures them): the record stream as
 //! `decode` prints it, or a per-node table redrawn in place (`--table`), and
 //! the values of chosen PDO fields charted as SVG on exit (`--plot`).
 //!
@@ -378,7 +380,10 @@ pub fn run(args: MonitorArgs) -> ExitCode {
         true => View::Terminal,
         false => View::Plain,
     });
-    let nodes: Vec<u8> = args.files.nodes.iter().map(|(n, _)| *n).collect();
+    // The nodes with a file: of --node or of the bus file.
+    let nodes: Vec<u8> = (1..=127)
+        .filter(|&n| decoder.dictionary(n).is_some())
+        .collect();
     let mut monitor = Monitor::new(decoder, &nodes, view, args.plot.clone())
         .with_format(args.format, args.unix_time)
         .with_title(format!("eds2rust monitor {}", args.iface));
