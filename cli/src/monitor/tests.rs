@@ -195,7 +195,7 @@ fn a_bus_file_gives_the_nodes_and_the_pdos_the_network_configures() {
         .collect();
     assert_eq!(nodes, [5, 32, 40]);
     let mut m = Monitor::new(decoder, &nodes, None, Vec::new()).with_format(OutFormat::Json, false);
-    // Velocity 1000, torque -5 (0.1 % of the rated torque).
+    // Velocity 1000 mm/s, torque -5 % of the rated torque.
     let tpdo2 = frame(0x2A8, &[0xE8, 0x03, 0x00, 0x00, 0xFB, 0xFF]);
     let out = feed(&mut m, &[(0.1, tpdo2)]);
     let line: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
