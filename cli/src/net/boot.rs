@@ -22,7 +22,7 @@ use clap::{Args, ValueEnum};
 use eds2rust_runtime::blocking::{self, Error};
 use eds2rust_runtime::boot::{NetworkPlan, SlaveStatus};
 use eds2rust_runtime::master;
-use eds2rust_runtime::transport::Bus;
+use eds2rust_runtime::transport::{Bus, Clock};
 
 use crate::ReadArgs;
 
@@ -104,7 +104,7 @@ pub(crate) fn run(args: BootArgs) -> ExitCode {
     };
     drop(err);
     let bus = crate::live::bus::LiveBus::new(bus);
-    finish(&args, &plan, boot(bus, &plan, timeout))
+    finish(&args, &plan, boot(bus, Clock::new(), &plan, timeout))
 }
 
 /// Prints the outcome in `args.format`; the exit status.
@@ -152,17 +152,18 @@ pub(crate) fn default_timeout(plan: &NetworkPlan) -> Duration {
     wait + heartbeat + SDO_TIMEOUT + SDO_STEP * u32::try_from(steps).unwrap_or(u32::MAX)
 }
 
-/// Boots `plan`'s network on `bus` with the blocking master (its own
-/// boot-up message first), waiting at most `timeout` for the boot to be
-/// decided. `Err` when the plan's master part cannot be set up or the bus
-/// fails.
+/// Boots `plan`'s network on `bus` with the blocking master on `clock`
+/// (its own boot-up message first), waiting at most `timeout` for the
+/// boot to be decided. `Err` when the plan's master part cannot be set up
+/// or the bus fails.
 pub(crate) fn boot<B: Bus>(
     bus: B,
+    clock: Clock,
     plan: &NetworkPlan,
     timeout: Duration,
 ) -> Result<Outcome, String> {
     let core = master::Master::for_network(plan).map_err(|e| e.to_string())?;
-    let mut m = blocking::Master::new(bus, core);
+    let mut m = blocking::Master::with_clock(bus, core, clock);
     m.start().map_err(|e| e.to_string())?;
     let started = m.now();
     let result = m.boot_network(plan.clone(), started + timeout);
