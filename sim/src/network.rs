@@ -209,6 +209,7 @@ impl Network {
                 .map(|f| f.fault)
                 .collect();
             let mut values = Vec::new();
+            let mut stored = Vec::new();
             for fault in &mine {
                 match *fault {
                     Fault::Identity(field, value) => values.push((field.object(), value)),
@@ -218,7 +219,7 @@ impl Network {
                     }
                     Fault::ConfigurationCurrent => {
                         let plan = self.plan.slave(slave.node).map(|s| &s.plan);
-                        let Some((date, time)) = plan.and_then(|p| p.configuration_date_time)
+                        let Some(plan) = plan.filter(|p| p.configuration_date_time.is_some())
                         else {
                             return Err(FaultError {
                                 fault: NodeFault::new(slave.node, *fault),
@@ -231,21 +232,26 @@ impl Network {
                                 ),
                             });
                         };
-                        values.push(((0x1020, 1), date));
-                        values.push(((0x1020, 2), time));
+                        stored = plan
+                            .configuration
+                            .iter()
+                            .map(|w| (w.index, w.sub_index, w.data.to_vec()))
+                            .collect();
                     }
                     _ => {}
                 }
             }
             let objects = with_values(slave.table.objects, &values);
-            nodes.push(SimNode::new(
+            let mut node = SimNode::new(
                 slave.name.clone(),
                 slave.node,
                 objects,
                 slave.drive,
                 &mine,
                 now,
-            ));
+            );
+            node.set_stored(stored);
+            nodes.push(node);
         }
         Ok(Simulation::new(nodes, now))
     }

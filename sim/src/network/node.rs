@@ -140,6 +140,8 @@ pub(super) struct SimNode {
     drive: bool,
     time_scale: f64,
     refused: Vec<(u16, u8, AbortCode)>,
+    /// Values the device holds saved (0x1010) from its first power-on.
+    stored: Vec<(u16, u8, Vec<u8>)>,
     pub(super) model: Option<Model>,
     pub(super) powered: bool,
     pub(super) heartbeat_off: bool,
@@ -197,11 +199,18 @@ impl SimNode {
             drive,
             time_scale: 1.0,
             refused,
+            stored: Vec::new(),
             model: None,
             powered: false,
             heartbeat_off: false,
             schedule,
         }
+    }
+
+    /// Has the device hold `values` saved (0x1010) from its first
+    /// power-on, as a device that was configured and stored before.
+    pub(super) fn set_stored(&mut self, values: Vec<(u16, u8, Vec<u8>)>) {
+        self.stored = values;
     }
 
     pub(super) fn set_time_scale(&mut self, factor: f64) {
@@ -240,7 +249,7 @@ impl SimNode {
     fn power_on(&self, now: Instant) -> Model {
         let config = DeviceConfig::node(self.node);
         let refused = self.refused.clone();
-        if self.drive {
+        let mut model = if self.drive {
             let inner = Cia402::new().with_time_scale(self.time_scale);
             let model = Refusing { inner, refused };
             let mut device = Device::new(self.objects, config, model, now);
@@ -255,7 +264,25 @@ impl SimNode {
                 Refusing { inner: (), refused },
                 now,
             )))
+        };
+        if !self.stored.is_empty() {
+            // Configured and saved before: the values go in and are saved,
+            // then the device is powered on with them (the first boot-up,
+            // from the defaults, is not on the bus).
+            each!(&mut model, d => {
+                d.with_model(now, |_, ctx| {
+                    for (index, sub, data) in &self.stored {
+                        // An entry the table refuses keeps its default.
+                        let _ = ctx.table_mut().set_raw(*index, *sub, data);
+                    }
+                });
+                d.save();
+                while d.poll_transmit().is_some() {}
+                while d.poll_event().is_some() {}
+            });
+            model.power_cycle(now);
         }
+        model
     }
 
     /// The powered device.
