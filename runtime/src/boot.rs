@@ -10,7 +10,8 @@
 //! The steps, in order: reset the node (communication or whole node) and
 //! wait for its boot-up message, or wait for it without a reset; read and
 //! check the device type (0x1000) and the identity (0x1018 sub 1–4; an
-//! expected 0 is not checked); check the software version (0x1F56 sub 1)
+//! expected 0 is not checked; 0x1000 is always read, as its answer tells
+//! that the node is there: a timeout is status B, a refusal is an answer); check the software version (0x1F56 sub 1)
 //! where one is expected; read the configuration date and time (0x1020
 //! sub 1 and 2) and skip the configuration when they match, else write
 //! every configuration entry in order; wait for the first heartbeat where
@@ -282,14 +283,21 @@ impl SlaveBoot {
                 let (index, sub, status) = IDENTITY[i];
                 let expected = self.expected(i);
                 match value {
-                    // No answer to 0x1000 at all: B; a refused identity read: that entry's status.
-                    Err(abort) if i == 0 => Err(self.fail(
+                    // No answer to 0x1000 at all (the SDO timed out): B.
+                    Err(AbortCode::Timeout) if i == 0 => Err(self.fail(
                         BootStatus::NoResponse,
                         Some((index, sub)),
                         None,
                         None,
-                        Some(abort),
+                        Some(AbortCode::Timeout),
                     )),
+                    // A refusal is an answer: the node is there. Without
+                    // an expected device type that is all the read asks.
+                    Err(_) if i == 0 && expected == 0 => {
+                        self.stage = self.first_identity(1);
+                        Ok(self.after_identity())
+                    }
+                    // A refused identity read: that entry's status.
                     Err(abort) => Err(self.fail(
                         status,
                         Some((index, sub)),

@@ -187,6 +187,13 @@ impl<B: Behaviour> Device<B> {
         r
     }
 
+    /// Saves what the table holds now, as a write of "save" to 0x1010
+    /// does: it survives resets and power cycles.
+    pub fn save(&mut self) {
+        let d = self.server.store_mut();
+        d.saved = Some(d.table.clone());
+    }
+
     /// Switches the device off and on again at `now`: values not saved
     /// (0x1010) return to their defaults, the LSS-stored node id is used.
     pub fn power_cycle(&mut self, now: Instant) {

@@ -140,8 +140,14 @@ pub fn load_with_overlays(
             });
         }
     };
-    let mut warnings = lines(Severity::Warning);
-    let objects = convert(&device, &mut warnings);
+    Ok(from_device(path, &device, lines(Severity::Warning)))
+}
+
+/// The table of `device`, already read from `path` (by a bus file's
+/// reader, for example), with the reader's `warnings` (what the
+/// conversion drops is added to them).
+pub fn from_device(path: &Path, device: &Device, mut warnings: Vec<String>) -> LoadedTable {
+    let objects = convert(device, &mut warnings);
     let device_type = objects
         .iter()
         .find(|o| (o.index, o.subindex) == (DEVICE_TYPE, 0))
@@ -149,14 +155,14 @@ pub fn load_with_overlays(
             Some(DefaultValue::Number(Number::Int(v))) => u32::try_from(v).ok(),
             _ => None,
         });
-    let cia402 = eds2rust::profiles::is_cia402(&device);
+    let cia402 = eds2rust::profiles::is_cia402(device);
     let node = device
         .commissioning
         .as_ref()
         .and_then(|c| c.node_id)
         .or(device.network.node_id)
         .and_then(NodeId::new);
-    Ok(LoadedTable {
+    LoadedTable {
         path: path.to_path_buf(),
         objects: Box::leak(objects.into_boxed_slice()),
         device_type,
@@ -164,7 +170,7 @@ pub fn load_with_overlays(
         node,
         product: device.identity.product_name.clone(),
         warnings,
-    })
+    }
 }
 
 /// Every value-carrying entry of `device` (type definitions left out), in

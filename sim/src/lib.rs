@@ -16,6 +16,9 @@
 //!   controlword and a statusword (docs/cia402-sim.md).
 //! - `file` (feature `files`) reads the table of a device from an
 //!   EDS/DCF/YAML file at run time, for devices without generated code.
+//! - `network` (feature `files`) simulates every slave of a bus file,
+//!   with faults (missing, wrong identity, late boot, power loss, SDO
+//!   abort, heartbeat stop), as one service.
 //! - [`bench`](mod@bench) runs a master and a device in virtual time, for tests.
 //! - [`harness`] runs a simulator and a master on the virtual bus (or, with
 //!   the feature `socketcan`, on a SocketCAN interface), with an optional
@@ -36,6 +39,8 @@ pub mod file;
 pub mod harness;
 #[cfg(feature = "seed-models")]
 pub mod models;
+#[cfg(feature = "files")]
+pub mod network;
 pub mod program;
 pub mod store;
 

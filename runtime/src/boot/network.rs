@@ -289,6 +289,16 @@ impl NetworkBoot {
             booting && slave.boot.as_ref().is_some_and(SlaveBoot::awaits_heartbeat);
         let without_reset = slave.config.plan.reset.is_none() || self.plan.reset_all_nodes;
         let lost = slave.status.state == SlaveState::Lost;
+        // A boot-up while the read of 0x1000 that follows a boot-up is in
+        // flight: the boot it starts would send that read again (two
+        // boot-ups in a row: one already on its way when the boot started,
+        // then the one of the reset the master asked for). Replacing the
+        // transfer would take the node's answer to the first read as the
+        // answer to the second and fail on the next.
+        let reading_device_type = booting && slave.pending == Some(Pending::Read(0x1000, 0));
+        if state == NmtState::BootUp && reading_device_type {
+            return;
+        }
         if state == NmtState::BootUp {
             if !awaiting_boot_up {
                 // It reset by itself: everything it was told is gone.
@@ -631,3 +641,6 @@ fn wait_end(plan: &NetworkPlan, deadline: Option<Instant>, first: bool, now: Ins
         _ => now + plan.response_time,
     }
 }
+
+#[cfg(test)]
+mod tests;

@@ -185,3 +185,43 @@ fn the_statuses_are_a_to_o() {
     let letters: Vec<char> = BootStatus::ALL.iter().map(|s| s.letter()).collect();
     assert_eq!(letters, ('A'..='O').collect::<Vec<_>>());
 }
+
+#[test]
+fn a_refused_device_type_read_is_an_answer_unless_one_is_expected() {
+    // Expected 0: the node answered (a device without 0x1000); boot on.
+    let mut unchecked = plan();
+    unchecked.device_type = 0;
+    let mut boot = SlaveBoot::new(unchecked);
+    boot.poll_request();
+    boot.poll_request();
+    boot.boot_up(NmtState::BootUp);
+    boot.poll_request();
+    let events = boot.read_done(Err(AbortCode::ObjectDoesNotExist)).unwrap();
+    assert!(events.is_empty());
+    assert_eq!(
+        boot.poll_request(),
+        Some(Request::Read {
+            index: 0x1018,
+            sub_index: 1
+        })
+    );
+    // Expected: the refusal is status C with the abort, not B.
+    let mut boot = SlaveBoot::new(plan());
+    boot.poll_request();
+    boot.poll_request();
+    boot.boot_up(NmtState::BootUp);
+    boot.poll_request();
+    let error = boot
+        .read_done(Err(AbortCode::ObjectDoesNotExist))
+        .unwrap_err();
+    assert_eq!(error.status, BootStatus::DeviceType);
+    assert_eq!(error.abort, Some(AbortCode::ObjectDoesNotExist));
+    // A timeout is no answer: B.
+    let mut boot = SlaveBoot::new(plan());
+    boot.poll_request();
+    boot.poll_request();
+    boot.boot_up(NmtState::BootUp);
+    boot.poll_request();
+    let error = boot.read_done(Err(AbortCode::Timeout)).unwrap_err();
+    assert_eq!(error.status, BootStatus::NoResponse);
+}

@@ -1,0 +1,261 @@
+//! A whole network simulated from its bus file (feature `files`): every
+//! slave the bus file lists becomes a simulated device built from its
+//! device file ([`crate::file`]), at the node id the bus file gives it,
+//! with the generic CiA 402 drive ([`crate::cia402`]) for a device that
+//! has a controlword and a statusword. All of them run as one sans-IO
+//! [`Service`](eds2rust_runtime::Service), [`Simulation`], on the virtual
+//! bus, on a SocketCAN interface, or behind a master's own bus in one
+//! thread ([`InlineBus`], in virtual time for tests).
+//!
+//! [`Fault`]s make it go wrong as real machines do, per node: missing,
+//! a wrong identity, a late boot, a power loss, an SDO abort during
+//! configuration, a heartbeat that stops, a configuration already
+//! current.
+//!
+//! ```no_run
+//! # use eds2rust_runtime::{Instant, od::NodeId};
+//! # use eds2rust_sim::network::{Fault, Network, NodeFault};
+//! let network = Network::load("bus.yml")?;
+//! let plan = network.plan().clone(); // what a master boots it by
+//! let axis = NodeId::new(40).unwrap();
+//! let sim = network.simulation(&[NodeFault::new(axis, Fault::Missing)], Instant::ZERO)?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+
+mod fault;
+mod inline;
+mod node;
+mod simulation;
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use eds2rust::diag::{Diagnostics, Severity};
+use eds2rust::input::Options;
+use eds2rust::network::config::Configured;
+use eds2rust::network::model::Bus;
+use eds2rust_runtime::Instant;
+use eds2rust_runtime::boot::NetworkPlan;
+use eds2rust_runtime::od::NodeId;
+
+pub use fault::{DEFAULT_ABORT, Fault, IdentityField, NodeFault};
+pub use inline::{InlineBus, TICK};
+pub use simulation::{Event, Simulation};
+
+use crate::file::{self, LoadError, LoadedTable};
+use node::{SimNode, with_values};
+
+/// One slave of the network, as simulated.
+#[derive(Debug, Clone)]
+pub struct Slave {
+    /// Its name in the bus file.
+    pub name: String,
+    /// The node id the bus file gives it.
+    pub node: NodeId,
+    /// Its device file's table.
+    pub table: LoadedTable,
+    /// Whether it runs the generic CiA 402 drive (its table has 0x6040
+    /// and 0x6041).
+    pub drive: bool,
+}
+
+/// A network read from its bus file, ready to be simulated.
+#[derive(Debug, Clone)]
+pub struct Network {
+    /// The bus file.
+    pub file: PathBuf,
+    /// The slaves, in node id order.
+    pub slaves: Vec<Slave>,
+    /// What a CiA 302-2 master boots this network by
+    /// (`eds2rust::network::boot_plan`).
+    pub plan: NetworkPlan,
+    /// The readers' warnings, one line each (`file:line: warning: ...`).
+    pub warnings: Vec<String>,
+}
+
+/// A fault that does not fit the network.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FaultError {
+    /// The fault.
+    pub fault: NodeFault,
+    /// Why it does not fit, and what to do.
+    pub reason: String,
+}
+
+impl fmt::Display for FaultError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "fault `{}`: {}", self.fault, self.reason)
+    }
+}
+
+impl std::error::Error for FaultError {}
+
+fn lines(diagnostics: &Diagnostics, severity: Severity) -> Vec<String> {
+    diagnostics
+        .iter()
+        .filter(|d| d.severity == severity)
+        .map(ToString::to_string)
+        .collect()
+}
+
+impl Network {
+    /// Reads the bus file at `path` and its device files (leniently, as
+    /// `eds2rust check` without `--strict`), configures it as dcfgen does
+    /// and builds every slave's table. Errors name file, line and key.
+    pub fn load(path: impl AsRef<Path>) -> Result<Network, LoadError> {
+        let path = path.as_ref();
+        let loaded = eds2rust::network::read_file(path, &Options::lenient());
+        let errors = lines(&loaded.diagnostics, Severity::Error);
+        let bus = match loaded.bus {
+            Some(bus) if errors.is_empty() => bus,
+            _ => {
+                return Err(LoadError {
+                    path: path.to_path_buf(),
+                    errors,
+                });
+            }
+        };
+        let (configured, diagnostics) = eds2rust::network::configure(&bus);
+        let errors = lines(&diagnostics, Severity::Error);
+        if !errors.is_empty() {
+            return Err(LoadError {
+                path: path.to_path_buf(),
+                errors,
+            });
+        }
+        let mut network = Network::from_bus(&bus, &configured);
+        let mut warnings = lines(&loaded.diagnostics, Severity::Warning);
+        warnings.extend(lines(&diagnostics, Severity::Warning));
+        warnings.append(&mut network.warnings);
+        network.warnings = warnings;
+        Ok(network)
+    }
+
+    /// The network of a bus file already read and configured
+    /// (`eds2rust::network::read_file`, `configure`): its plan
+    /// (`boot_plan`) and each configured slave's device table (with the
+    /// conversion's warnings).
+    pub fn from_bus(bus: &Bus, configured: &Configured) -> Network {
+        let plan = eds2rust::network::boot_plan(bus, configured);
+        let mut slaves = Vec::new();
+        let mut warnings = Vec::new();
+        for node in &configured.nodes {
+            let (Some(id), Some(section)) = (NodeId::new(node.node_id), bus.slaves.get(node.slave))
+            else {
+                continue;
+            };
+            let mut table = file::from_device(&section.device_file, &section.device, Vec::new());
+            warnings.append(&mut table.warnings);
+            let drive = table.cia402_lacks().is_empty();
+            slaves.push(Slave {
+                name: node.name.clone(),
+                node: id,
+                table,
+                drive,
+            });
+        }
+        slaves.sort_by_key(|s| s.node);
+        Network {
+            file: bus.file.clone(),
+            slaves,
+            plan,
+            warnings,
+        }
+    }
+
+    /// The plan a master boots the network by.
+    pub fn plan(&self) -> &NetworkPlan {
+        &self.plan
+    }
+
+    /// The slave `node`.
+    pub fn slave(&self, node: NodeId) -> Option<&Slave> {
+        self.slaves.iter().find(|s| s.node == node)
+    }
+
+    /// The node id of the slave named `name` in the bus file.
+    pub fn node_named(&self, name: &str) -> Option<NodeId> {
+        self.slaves.iter().find(|s| s.name == name).map(|s| s.node)
+    }
+
+    /// The simulation of every slave, started at `now`, with `faults`
+    /// (several per node are applied together). A fault on a node the
+    /// network does not have, or a [`Fault::ConfigurationCurrent`] on a
+    /// node whose configuration carries no date and time, is an error.
+    pub fn simulation(&self, faults: &[NodeFault], now: Instant) -> Result<Simulation, FaultError> {
+        for fault in faults {
+            if self.slave(fault.node).is_none() {
+                let known: Vec<String> = self
+                    .slaves
+                    .iter()
+                    .map(|s| format!("{} ({})", s.node, s.name))
+                    .collect();
+                return Err(FaultError {
+                    fault: *fault,
+                    reason: format!(
+                        "{} has no slave with node id {}; its slaves: {}",
+                        self.file.display(),
+                        fault.node,
+                        known.join(", ")
+                    ),
+                });
+            }
+        }
+        let mut nodes = Vec::new();
+        for slave in &self.slaves {
+            let mine: Vec<Fault> = faults
+                .iter()
+                .filter(|f| f.node == slave.node)
+                .map(|f| f.fault)
+                .collect();
+            let mut values = Vec::new();
+            let mut stored = Vec::new();
+            for fault in &mine {
+                match *fault {
+                    Fault::Identity(field, value) => values.push((field.object(), value)),
+                    Fault::ConfigurationDate { date, time } => {
+                        values.push(((0x1020, 1), date));
+                        values.push(((0x1020, 2), time));
+                    }
+                    Fault::ConfigurationCurrent => {
+                        let plan = self.plan.slave(slave.node).map(|s| &s.plan);
+                        let Some(plan) = plan.filter(|p| p.configuration_date_time.is_some())
+                        else {
+                            return Err(FaultError {
+                                fault: NodeFault::new(slave.node, *fault),
+                                reason: format!(
+                                    "the configuration of `{}` in {} carries no date and time; \
+                                     add `sdo:` writes of 0x1020 sub 1 (date) and sub 2 (time) \
+                                     to its section",
+                                    slave.name,
+                                    self.file.display()
+                                ),
+                            });
+                        };
+                        stored = plan
+                            .configuration
+                            .iter()
+                            .map(|w| (w.index, w.sub_index, w.data.to_vec()))
+                            .collect();
+                    }
+                    _ => {}
+                }
+            }
+            let objects = with_values(slave.table.objects, &values);
+            let mut node = SimNode::new(
+                slave.name.clone(),
+                slave.node,
+                objects,
+                slave.drive,
+                &mine,
+                now,
+            );
+            node.set_stored(stored);
+            nodes.push(node);
+        }
+        Ok(Simulation::new(nodes, now))
+    }
+}
+
+#[cfg(test)]
+mod tests;

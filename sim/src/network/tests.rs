@@ -1,0 +1,141 @@
+use std::ops::ControlFlow;
+use std::path::PathBuf;
+use std::time::Duration;
+
+use eds2rust_runtime::blocking;
+use eds2rust_runtime::boot::SlaveState;
+use eds2rust_runtime::master::Master;
+use eds2rust_runtime::od::NodeId;
+use eds2rust_runtime::transport::ManualClock;
+use eds2rust_runtime::{Instant, Service};
+
+use super::*;
+
+fn machine() -> Network {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../eds/machine/bus.yml");
+    Network::load(&path).unwrap_or_else(|e| panic!("{e}"))
+}
+
+fn node(id: u8) -> NodeId {
+    NodeId::new(id).unwrap()
+}
+
+fn frames(sim: &mut Simulation) -> Vec<String> {
+    std::iter::from_fn(|| sim.poll_transmit())
+        .map(|f| f.to_string())
+        .collect()
+}
+
+#[test]
+fn the_seed_machine_loads_with_its_node_ids_and_drives() {
+    let network = machine();
+    let nodes: Vec<(u8, &str, bool)> = network
+        .slaves
+        .iter()
+        .map(|s| (s.node.get(), s.name.as_str(), s.drive))
+        .collect();
+    assert_eq!(
+        nodes,
+        [
+            (5, "conveyor", true),
+            (32, "actuator", false),
+            (40, "axis", true)
+        ]
+    );
+    assert_eq!(network.plan().slaves.len(), 3);
+    assert_eq!(network.node_named("axis"), Some(node(40)));
+}
+
+#[test]
+fn every_slave_boots_unless_missing_or_late() {
+    let network = machine();
+    let faults = [
+        NodeFault::new(node(32), Fault::Missing),
+        NodeFault::new(node(40), Fault::LateBoot(Duration::from_millis(300))),
+    ];
+    let mut sim = network.simulation(&faults, Instant::ZERO).unwrap();
+    assert_eq!(frames(&mut sim), ["705#00"]);
+    assert!(!sim.is_powered(node(32)));
+    assert_eq!(
+        sim.poll_timeout(),
+        Some(Instant::from_millis(300)).min(sim.poll_timeout())
+    );
+    let mut t = Instant::ZERO;
+    let mut seen = Vec::new();
+    while t < Instant::from_millis(400) {
+        t = sim.poll_timeout().unwrap();
+        sim.handle_timeout(t);
+        seen.extend(frames(&mut sim).into_iter().map(|f| (t, f)));
+    }
+    assert!(
+        seen.contains(&(Instant::from_millis(300), "728#00".to_string())),
+        "{seen:?}"
+    );
+    assert!(!seen.iter().any(|(_, f)| f.starts_with("720#")));
+}
+
+#[test]
+fn a_fault_on_a_node_the_network_lacks_names_its_slaves() {
+    let network = machine();
+    let error = network
+        .simulation(&[NodeFault::new(node(9), Fault::Missing)], Instant::ZERO)
+        .unwrap_err();
+    assert!(
+        error.to_string().contains("no slave with node id 9"),
+        "{error}"
+    );
+    assert!(error.to_string().contains("40 (axis)"), "{error}");
+    let error = network
+        .simulation(
+            &[NodeFault::new(node(40), Fault::ConfigurationCurrent)],
+            Instant::ZERO,
+        )
+        .unwrap_err();
+    assert!(error.to_string().contains("0x1020"), "{error}");
+}
+
+#[test]
+fn the_blocking_master_boots_the_machine_in_virtual_time() {
+    let network = machine();
+    let time = ManualClock::new();
+    let faults = [NodeFault::new(
+        node(5),
+        Fault::Identity(IdentityField::ProductCode, 0xDEAD),
+    )];
+    let sim = network.simulation(&faults, time.now()).unwrap();
+    let bus = InlineBus::manual(sim, time.clone()).with_trace();
+    let core = Master::for_network(network.plan()).unwrap();
+    let mut master = blocking::Master::with_clock(bus, core, time.clock());
+    master.start().unwrap();
+    let real = std::time::Instant::now();
+    let report = master
+        .boot_network(network.plan().clone(), Instant::from_millis(10_000))
+        .unwrap();
+    assert!(real.elapsed() < Duration::from_secs(5));
+    let states: Vec<(u8, SlaveState)> = report
+        .slaves
+        .iter()
+        .map(|s| (s.node.get(), s.state))
+        .collect();
+    assert_eq!(
+        states,
+        [
+            (5, SlaveState::Failed),
+            (32, SlaveState::Operational),
+            (40, SlaveState::Operational)
+        ],
+        "{:#?}",
+        report
+    );
+    // The PDOs flow afterwards.
+    master
+        .run_until(time.now() + Duration::from_millis(100), |_| {
+            ControlFlow::<()>::Continue(())
+        })
+        .ok();
+    let bus = master.bus();
+    assert_eq!(
+        bus.service().nmt_state(node(40)),
+        Some(eds2rust_runtime::nmt::NmtState::Operational)
+    );
+}
