@@ -12,6 +12,7 @@
 //! errors, 2 on usage errors.
 
 mod report;
+mod simulate;
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -25,6 +26,7 @@ use eds2rust_runtime::master;
 use eds2rust_runtime::transport::{Bus, Clock};
 
 use crate::ReadArgs;
+use crate::live::bus::LiveBus;
 
 pub(crate) use report::{Outcome, render_json, render_text};
 
@@ -86,25 +88,15 @@ pub(crate) fn run(args: BootArgs) -> ExitCode {
     let _ = write!(err, "{}", network.warnings.render());
     let plan = eds2rust::network::boot_plan(&network.bus, &network.configured);
     let timeout = args.timeout.unwrap_or_else(|| default_timeout(&plan));
-    let bus: Box<dyn Bus + Send> = if args.simulate {
-        let _ = writeln!(
-            err,
-            "error: --simulate: the network simulation is not available in this build"
-        );
-        return ExitCode::from(1);
+    drop(err);
+    let outcome = if args.simulate {
+        simulate::boot(&network, &plan, &[], timeout)
     } else {
         let iface = args.iface.as_deref().unwrap_or_default();
-        match crate::live::bus::open_socketcan(iface) {
-            Ok(bus) => bus,
-            Err(message) => {
-                let _ = writeln!(err, "error: {message}");
-                return ExitCode::from(1);
-            }
-        }
+        crate::live::bus::open_socketcan(iface)
+            .and_then(|bus| boot(LiveBus::new(bus), Clock::new(), &plan, timeout))
     };
-    drop(err);
-    let bus = crate::live::bus::LiveBus::new(bus);
-    finish(&args, &plan, boot(bus, Clock::new(), &plan, timeout))
+    finish(&args, &plan, outcome)
 }
 
 /// Prints the outcome in `args.format`; the exit status.
@@ -189,6 +181,7 @@ pub(crate) fn boot<B: Bus>(
         started,
         ended,
         timeout,
+        simulated: false,
     })
 }
 

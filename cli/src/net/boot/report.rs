@@ -34,6 +34,8 @@ pub(crate) struct Outcome {
     pub started: Instant,
     pub ended: Instant,
     pub timeout: Duration,
+    /// The bus was the network's simulation, in virtual time.
+    pub simulated: bool,
 }
 
 impl Outcome {
@@ -184,8 +186,13 @@ fn summary(bus: &str, plan: &NetworkPlan, outcome: &Outcome) -> String {
                 "booted"
             };
             let mut line = format!(
-                "{bus}: {up} of {} slaves {what} in {seconds:.3} s",
-                outcome.slaves.len()
+                "{bus}: {up} of {} slaves {what} in {seconds:.3} s{}",
+                outcome.slaves.len(),
+                if outcome.simulated {
+                    " (simulated time)"
+                } else {
+                    ""
+                }
             );
             if !failed.is_empty() {
                 let optional: Vec<&&SlaveStatus> = failed.iter().collect();
@@ -266,6 +273,7 @@ pub(crate) fn render_json(bus: &str, plan: &NetworkPlan, outcome: &Outcome) -> S
         "running": outcome.running(plan),
         "decided": outcome.decided,
         "seconds": (outcome.ended - outcome.started).as_secs_f64(),
+        "simulated": outcome.simulated,
         "summary": summary(bus, plan, outcome),
         "slaves": slaves,
     });
