@@ -1,0 +1,140 @@
+//! `eds2rust net boot --simulate`: the seed machine (eds/machine/bus.yml)
+//! and the fault-matrix network (tests/networks/boot/bus.yml) booted
+//! against their own simulation, in virtual time: the table is the same on
+//! every run and locked by a snapshot; exit codes and usage errors.
+
+mod common;
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Runs the binary in the workspace root (paths in the output are as
+/// given): exit code, stdout, stderr.
+fn run(args: &[&str]) -> (i32, String, String) {
+    let out = Command::new(common::BIN)
+        .args(args)
+        .current_dir(root())
+        .output()
+        .expect("run eds2rust");
+    (
+        out.status.code().expect("exit code"),
+        String::from_utf8(out.stdout).unwrap(),
+        String::from_utf8(out.stderr).unwrap(),
+    )
+}
+
+#[test]
+fn the_seed_machine_boots_in_its_simulation() {
+    let (code, stdout, stderr) = run(&["net", "boot", "--simulate", "eds/machine/bus.yml"]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    insta::assert_snapshot!("net_boot_seed_machine", stdout);
+}
+
+#[test]
+fn every_slave_row_says_what_its_boot_did() {
+    let (code, stdout, stderr) = run(&["net", "boot", "--simulate", "tests/networks/boot/bus.yml"]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let rows: Vec<Vec<&str>> = stdout
+        .lines()
+        .filter(|l| l.starts_with('|'))
+        .map(|l| l.trim_matches('|').split('|').map(str::trim).collect())
+        .collect();
+    assert_eq!(
+        rows,
+        [
+            vec![
+                "node",
+                "name",
+                "mandatory",
+                "identity",
+                "configuration",
+                "state",
+                "time",
+                "boot error"
+            ],
+            vec![
+                "2",
+                "left",
+                "yes",
+                "ok",
+                "4 entries written",
+                "operational",
+                "0.050 s",
+                ""
+            ],
+            vec![
+                "3",
+                "right",
+                "no",
+                "ok",
+                "4 entries written",
+                "operational",
+                "0.050 s",
+                ""
+            ],
+        ],
+        "{stdout}"
+    );
+    assert!(
+        stdout.ends_with(
+            "tests/networks/boot/bus.yml: 2 of 2 slaves operational in 0.050 s (simulated time)\n"
+        ),
+        "{stdout}"
+    );
+}
+
+#[test]
+fn json_has_the_outcome_and_every_slave() {
+    let (code, stdout, stderr) = run(&[
+        "net",
+        "boot",
+        "--simulate",
+        "--format",
+        "json",
+        "tests/networks/boot/bus.yml",
+    ]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON object");
+    assert_eq!(v["running"], true);
+    assert_eq!(v["decided"], true);
+    assert_eq!(v["simulated"], true);
+    let slaves = v["slaves"].as_array().expect("slaves");
+    assert_eq!(slaves.len(), 2);
+    assert_eq!(slaves[0]["node"], 2);
+    assert_eq!(slaves[0]["name"], "left");
+    assert_eq!(slaves[0]["state"], "operational");
+    assert_eq!(slaves[0]["entries_written"], 4);
+    assert_eq!(slaves[0]["error"], serde_json::Value::Null);
+}
+
+#[test]
+fn usage_and_input_errors() {
+    let bus = "tests/networks/boot/bus.yml";
+    // Neither --iface nor --simulate, or both: usage errors.
+    assert_eq!(run(&["net", "boot", bus]).0, 2);
+    assert_eq!(
+        run(&["net", "boot", "--simulate", "--iface", "vcan0", bus]).0,
+        2
+    );
+    assert_eq!(
+        run(&["net", "boot", "--simulate", "--timeout", "0", bus]).0,
+        2
+    );
+    // A bus file with errors is not booted.
+    let (code, _, stderr) = run(&[
+        "net",
+        "boot",
+        "--simulate",
+        "tests/networks/check/node-id/bus.yml",
+    ]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("not booted:"), "{stderr}");
+    // An interface that is not there: 1, naming it.
+    let (code, _, stderr) = run(&["net", "boot", "--iface", "eds2rust-none0", bus]);
+    assert_eq!(code, 1, "{stderr}");
+    assert!(stderr.contains("eds2rust-none0"), "{stderr}");
+}
