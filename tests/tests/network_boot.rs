@@ -462,6 +462,25 @@ fn a_lost_heartbeat_is_status_e_and_its_return_boots_the_slave_again() {
 }
 
 #[test]
+fn a_heartbeat_that_never_starts_is_status_k() {
+    let stops = Fault::HeartbeatStops {
+        at: Duration::ZERO,
+        resume: None,
+    };
+    let mut rig = Rig::new(&[(LEFT, stops)]);
+    let report = rig.boot();
+    assert!(!report.booted);
+    let e = error(&report, LEFT);
+    assert_eq!(e.status, BootStatus::HeartbeatNotStarted);
+    assert_eq!(e.status.letter(), 'K');
+    assert_eq!(e.object, Some((0x1017, 0)));
+    // Identified and configured first.
+    let steps = rig.steps(LEFT);
+    let n = entries(&rig.network, LEFT);
+    assert_eq!(steps, full_boot(n)[..3].to_vec());
+}
+
+#[test]
 fn a_slave_booting_late_within_the_boot_time_is_booted() {
     let mut rig = Rig::new(&[(LEFT, Fault::LateBoot(Duration::from_millis(600)))]);
     let report = rig.boot();

@@ -189,3 +189,25 @@ fn the_seed_machine_boots_and_its_pdos_flow_both_ways() {
     // The conveyor's TPDO 4 each SYNC.
     assert!(count(0x485) >= 19, "{}", count(0x485));
 }
+
+#[test]
+fn an_inline_bus_on_the_real_clock_boots_the_machine_in_real_time() {
+    let network = machine();
+    let clock = eds2rust_runtime::transport::Clock::new();
+    let sim = network.simulation(&[], clock.now()).unwrap();
+    let bus = InlineBus::new(sim, clock.clone());
+    let core = Master::for_network(network.plan()).unwrap();
+    let mut master = blocking::Master::with_clock(bus, core, clock);
+    master.start().unwrap();
+    let real = std::time::Instant::now();
+    let report = master
+        .boot_network(
+            network.plan().clone(),
+            std::time::Instant::now() + Duration::from_secs(10),
+        )
+        .unwrap();
+    assert!(report.booted, "{report:#?}");
+    // Waits for the first heartbeats (100 ms) took real time, not more.
+    let took = real.elapsed();
+    assert!(took < Duration::from_secs(3), "{took:?}");
+}
