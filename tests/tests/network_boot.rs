@@ -15,7 +15,8 @@ use std::time::Duration;
 
 use eds2rust_runtime::blocking;
 use eds2rust_runtime::boot::{
-    BootError, BootEvent, BootStatus, Configuration, NetworkEvent, NetworkReport, SlaveState,
+    BootError, BootEvent, BootStatus, Configuration, NetworkEvent, NetworkPlan, NetworkReport,
+    SlaveState, Supervision,
 };
 use eds2rust_runtime::master::{Master, MasterEvent};
 use eds2rust_runtime::od::NodeId;
@@ -47,7 +48,14 @@ struct Rig {
 
 impl Rig {
     fn new(faults: &[(u8, Fault)]) -> Rig {
-        let network = network();
+        Rig::with_plan(faults, |_| {})
+    }
+
+    /// [`Rig::new`] with the plan changed by `edit` (flags the bus file
+    /// does not set).
+    fn with_plan(faults: &[(u8, Fault)], edit: impl FnOnce(&mut NetworkPlan)) -> Rig {
+        let mut network = network();
+        edit(&mut network.plan);
         let time = ManualClock::new();
         let faults: Vec<NodeFault> = faults
             .iter()
@@ -454,6 +462,25 @@ fn a_lost_heartbeat_is_status_e_and_its_return_boots_the_slave_again() {
 }
 
 #[test]
+fn a_heartbeat_that_never_starts_is_status_k() {
+    let stops = Fault::HeartbeatStops {
+        at: Duration::ZERO,
+        resume: None,
+    };
+    let mut rig = Rig::new(&[(LEFT, stops)]);
+    let report = rig.boot();
+    assert!(!report.booted);
+    let e = error(&report, LEFT);
+    assert_eq!(e.status, BootStatus::HeartbeatNotStarted);
+    assert_eq!(e.status.letter(), 'K');
+    assert_eq!(e.object, Some((0x1017, 0)));
+    // Identified and configured first.
+    let steps = rig.steps(LEFT);
+    let n = entries(&rig.network, LEFT);
+    assert_eq!(steps, full_boot(n)[..3].to_vec());
+}
+
+#[test]
 fn a_slave_booting_late_within_the_boot_time_is_booted() {
     let mut rig = Rig::new(&[(LEFT, Fault::LateBoot(Duration::from_millis(600)))]);
     let report = rig.boot();
@@ -492,6 +519,110 @@ fn a_mandatory_slave_booting_after_the_boot_time_fails_the_network_then_boots() 
         .clone();
     assert_eq!(status.state, SlaveState::Booted, "{status:#?}");
     assert_eq!(status.error, None);
+}
+
+/// NMT commands on the bus (command, node; 0 for all).
+fn nmt(rig: &Rig) -> Vec<(u8, u8)> {
+    rig.frames(0x000)
+        .iter()
+        .map(|(_, f)| (f.data()[0], f.data()[1]))
+        .collect()
+}
+
+#[test]
+fn start_all_nodes_starts_them_with_one_command_at_the_end() {
+    let mut rig = Rig::with_plan(&[], |plan| plan.start_all_nodes = true);
+    let report = rig.boot();
+    assert!(report.booted);
+    let starts: Vec<(u8, u8)> = nmt(&rig).into_iter().filter(|(c, _)| *c == 0x01).collect();
+    assert_eq!(starts, [(0x01, 0)]);
+    assert_eq!(state(&report, LEFT), SlaveState::Operational);
+    assert_eq!(state(&report, RIGHT), SlaveState::Operational);
+    assert_eq!(
+        rig.sim().nmt_state(id(RIGHT)),
+        Some(eds2rust_runtime::nmt::NmtState::Operational)
+    );
+}
+
+#[test]
+fn reset_all_nodes_resets_them_with_one_command() {
+    let mut rig = Rig::with_plan(&[], |plan| plan.reset_all_nodes = true);
+    let report = rig.boot();
+    assert!(report.booted, "{report:#?}");
+    let resets: Vec<(u8, u8)> = nmt(&rig).into_iter().filter(|(c, _)| *c == 0x82).collect();
+    assert_eq!(resets, [(0x82, 0)]);
+    for node in [LEFT, RIGHT] {
+        assert_eq!(rig.steps(node), full_boot(entries(&rig.network, node)));
+    }
+}
+
+#[test]
+fn stop_all_nodes_stops_the_network_when_a_mandatory_slave_fails() {
+    let mut rig = Rig::with_plan(&[(LEFT, Fault::Missing)], |plan| {
+        plan.stop_all_nodes = true;
+    });
+    let report = rig.boot();
+    assert!(!report.booted);
+    assert!(nmt(&rig).contains(&(0x02, 0)), "{:?}", nmt(&rig));
+    rig.run(Duration::from_millis(50));
+    assert_eq!(
+        rig.sim().nmt_state(id(RIGHT)),
+        Some(eds2rust_runtime::nmt::NmtState::Stopped)
+    );
+}
+
+#[test]
+fn a_slave_the_master_does_not_boot_is_only_started() {
+    let mut rig = Rig::with_plan(&[], |plan| {
+        let mut slaves = plan.slaves.to_vec();
+        slaves[1].boot = false;
+        plan.slaves = slaves.into();
+    });
+    let report = rig.boot();
+    assert!(report.booted);
+    let right = report.slaves.iter().find(|s| s.node == id(RIGHT)).unwrap();
+    assert_eq!(right.configuration, Some(Configuration::NotManaged));
+    assert_eq!(right.state, SlaveState::Operational);
+    assert!(rig.frames(0x603).is_empty(), "no SDO to it");
+}
+
+#[test]
+fn a_guarded_slave_that_stops_answering_is_status_f_and_booted_again() {
+    let guarding = Supervision::Guarding {
+        guard_time: Duration::from_millis(50),
+        life_time_factor: std::num::NonZeroU8::new(3).unwrap(),
+    };
+    let at = Duration::from_millis(1500);
+    let off = Duration::from_millis(500);
+    let mut rig = Rig::with_plan(&[(RIGHT, Fault::PowerLoss { at, off })], |plan| {
+        let mut slaves = plan.slaves.to_vec();
+        slaves[1].supervision = guarding;
+        slaves[1].plan.heartbeat = false;
+        plan.slaves = slaves.into();
+    });
+    let report = rig.boot();
+    assert!(report.booted, "{report:#?}");
+    rig.run(Duration::from_millis(3000) - (rig.now() - Instant::ZERO));
+    // Guarded: remote frames on 0x703, answered while powered.
+    assert!(rig.frames(0x703).iter().any(|(_, f)| f.is_remote()));
+    let lost = rig.position("Lost", |e| {
+        *e == NetworkEvent::Lost {
+            node: id(RIGHT),
+            status: BootStatus::GuardingLost,
+        }
+    });
+    let rebooting = rig.position("Rebooting", |e| *e == NetworkEvent::Rebooting(id(RIGHT)));
+    assert!(lost < rebooting, "{:#?}", rig.events);
+    let status = rig
+        .master
+        .core()
+        .network()
+        .unwrap()
+        .slave(id(RIGHT))
+        .unwrap()
+        .clone();
+    assert_eq!(status.state, SlaveState::Operational, "{status:#?}");
+    assert_eq!(status.boots, 2);
 }
 
 #[test]

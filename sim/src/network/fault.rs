@@ -85,9 +85,9 @@ pub enum Fault {
         /// The abort code of the refusal.
         code: AbortCode,
     },
-    /// The node's heartbeat stops at `at` (it runs on otherwise, its
-    /// boot-up message included); with `resume`, it comes back that long
-    /// after it stopped.
+    /// The node's error control stops at `at`: no heartbeat, no answer to
+    /// node guarding (it runs on otherwise, its boot-up message
+    /// included); with `resume`, it comes back that long after it stopped.
     HeartbeatStops {
         /// When it stops.
         at: Duration,

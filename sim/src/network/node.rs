@@ -317,8 +317,9 @@ impl SimNode {
         }
     }
 
-    /// The next frame the node sends; heartbeats are dropped while its
-    /// heartbeat is stopped (the boot-up message still goes).
+    /// The next frame the node sends; heartbeats and guarding replies are
+    /// dropped while its error control is stopped (the boot-up message
+    /// still goes).
     pub(super) fn poll_transmit(&mut self) -> Option<Frame> {
         let heartbeat = CanId::Standard(0x700 + u16::from(self.node.get()));
         let off = self.heartbeat_off;

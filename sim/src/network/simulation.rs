@@ -83,14 +83,6 @@ impl Simulation {
         self.table(node)?.get_uint(index, sub)
     }
 
-    /// Sets the time scale of the CiA 402 drives' mechanics (for drives
-    /// powered on from now on).
-    pub fn set_time_scale(&mut self, factor: f64) {
-        for node in &mut self.nodes {
-            node.set_time_scale(factor);
-        }
-    }
-
     fn find(&self, node: NodeId) -> Option<&SimNode> {
         self.nodes.iter().find(|n| n.node == node)
     }

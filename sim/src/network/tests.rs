@@ -139,3 +139,75 @@ fn the_blocking_master_boots_the_machine_in_virtual_time() {
         Some(eds2rust_runtime::nmt::NmtState::Operational)
     );
 }
+
+#[test]
+fn the_seed_machine_boots_and_its_pdos_flow_both_ways() {
+    let network = machine();
+    let time = ManualClock::new();
+    let sim = network.simulation(&[], time.now()).unwrap();
+    let bus = InlineBus::manual(sim, time.clone()).with_trace();
+    let core = Master::for_network(network.plan()).unwrap();
+    let mut master = blocking::Master::with_clock(bus, core, time.clock());
+    master.start().unwrap();
+    let report = master
+        .boot_network(network.plan().clone(), Instant::from_millis(10_000))
+        .unwrap();
+    assert!(report.booted, "{report:#?}");
+    assert!(
+        report
+            .slaves
+            .iter()
+            .all(|s| s.state == SlaveState::Operational),
+        "{report:#?}"
+    );
+    let from = time.now();
+    // The process data the master sends to the axis: controlword 0x000F
+    // (enable operation), target 1000.
+    let now = master.now();
+    let axis_rpdo = eds2rust_runtime::CanId::Standard(0x228);
+    let tx = master
+        .core_mut()
+        .pdo_tx
+        .iter_mut()
+        .find(|tx| tx.can_id() == axis_rpdo)
+        .expect("the master sends the axis's RPDO 1");
+    tx.set_data(now, &[0x0F, 0x00, 0xE8, 0x03, 0x00, 0x00])
+        .unwrap();
+    master.run_for(Duration::from_millis(200)).unwrap();
+    let count = |id: u16| {
+        master
+            .bus()
+            .trace()
+            .iter()
+            .filter(|(t, f)| *t >= from && f.standard_id() == Some(id))
+            .count()
+    };
+    // The axis's TPDO 1 (statusword, position) and RPDO 1 (controlword,
+    // target, from the master) every 10 ms SYNC.
+    assert!(count(0x1A8) >= 19, "{}", count(0x1A8));
+    assert!(count(0x228) >= 19, "{}", count(0x228));
+    // The conveyor's TPDO 4 each SYNC.
+    assert!(count(0x485) >= 19, "{}", count(0x485));
+}
+
+#[test]
+fn an_inline_bus_on_the_real_clock_boots_the_machine_in_real_time() {
+    let network = machine();
+    let clock = eds2rust_runtime::transport::Clock::new();
+    let sim = network.simulation(&[], clock.now()).unwrap();
+    let bus = InlineBus::new(sim, clock.clone());
+    let core = Master::for_network(network.plan()).unwrap();
+    let mut master = blocking::Master::with_clock(bus, core, clock);
+    master.start().unwrap();
+    let real = std::time::Instant::now();
+    let report = master
+        .boot_network(
+            network.plan().clone(),
+            std::time::Instant::now() + Duration::from_secs(10),
+        )
+        .unwrap();
+    assert!(report.booted, "{report:#?}");
+    // Waits for the first heartbeats (100 ms) took real time, not more.
+    let took = real.elapsed();
+    assert!(took < Duration::from_secs(3), "{took:?}");
+}
