@@ -564,7 +564,7 @@ impl Failures {
     }
 }
 
-mod fault;
+pub(crate) mod fault;
 mod network;
 #[cfg(test)]
 mod tests;

@@ -87,6 +87,86 @@ fn every_slave_row_says_what_its_boot_did() {
     );
 }
 
+/// The mandatory slave missing: its boot fails with status B when the
+/// boot time (1 s) is over, the optional one boots; exit status 1 and a
+/// summary naming the slave, its node and the status.
+#[test]
+fn a_missing_mandatory_slave_fails_the_boot_with_status_b() {
+    let (code, stdout, stderr) = run(&[
+        "net",
+        "boot",
+        "--simulate",
+        "--fault",
+        "left:missing",
+        "tests/networks/boot/bus.yml",
+    ]);
+    assert_eq!(code, 1, "{stdout}{stderr}");
+    let row = |node: &str| -> Vec<String> {
+        stdout
+            .lines()
+            .map(|l| {
+                l.trim_matches('|')
+                    .split('|')
+                    .map(|c| c.trim().to_string())
+                    .collect::<Vec<_>>()
+            })
+            .find(|cells| cells.first().is_some_and(|c| c == node))
+            .unwrap_or_else(|| panic!("no row of node {node}:\n{stdout}"))
+    };
+    assert_eq!(
+        row("2"),
+        [
+            "2",
+            "left",
+            "yes",
+            "-",
+            "-",
+            "failed",
+            "1.000 s",
+            "node 2: boot error B: the node did not answer the read of its device type (0x1000) (0x1000 sub 0)"
+        ],
+        "{stdout}"
+    );
+    assert_eq!(row("3")[5], "operational", "{stdout}");
+    let summary = stdout.lines().last().unwrap_or_default();
+    assert_eq!(
+        summary,
+        "tests/networks/boot/bus.yml: the network did not boot: left: node 2: boot error B: \
+         the node did not answer the read of its device type (0x1000) (0x1000 sub 0)"
+    );
+
+    // The optional slave missing: the network runs (exit status 0), the
+    // summary names the slave that is not up.
+    let (code, stdout, stderr) = run(&[
+        "net",
+        "boot",
+        "--simulate",
+        "--fault",
+        "3:missing",
+        "tests/networks/boot/bus.yml",
+    ]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    assert!(
+        stdout.ends_with("optional slaves not up: right (node 3) B\n"),
+        "{stdout}"
+    );
+
+    // A wrong identity: status O, with the expected and found values.
+    let (code, stdout, _) = run(&[
+        "net",
+        "boot",
+        "--simulate",
+        "--fault",
+        "left:serial=5",
+        "tests/networks/boot/bus.yml",
+    ]);
+    assert_eq!(code, 1, "{stdout}");
+    assert!(
+        stdout.contains("| wrong ") && stdout.contains("expected 0x00C0FFEE, found 0x00000005"),
+        "{stdout}"
+    );
+}
+
 #[test]
 fn json_has_the_outcome_and_every_slave() {
     let (code, stdout, stderr) = run(&[

@@ -55,6 +55,19 @@ pub(crate) struct BootArgs {
     /// from its device file, in this process, on the virtual bus.
     #[arg(long, conflicts_with = "iface")]
     simulate: bool,
+    /// With --simulate: what goes wrong with a simulated slave,
+    /// NODE:KIND[=VALUE] as `eds2rust sim --network` takes it (NODE a
+    /// node id or a slave's name): missing, device-type=V, vendor-id=V,
+    /// product-code=V, revision=V, serial=V, late-boot=T,
+    /// power-loss=AT[+OFF], sdo-abort=INDEX:SUB[:CODE],
+    /// heartbeat-stops=AT[+FOR], config-current. May be given several
+    /// times.
+    #[arg(
+        long = "fault",
+        value_name = "NODE:KIND[=VALUE]",
+        requires = "simulate"
+    )]
+    faults: Vec<String>,
     /// The longest the whole boot may take (seconds: 2, 0.5, or 500ms,
     /// 2s, 1m). Default: the network's boot time (or the master's response
     /// time), plus the longest heartbeat wait, plus one SDO timeout, plus
@@ -90,7 +103,10 @@ pub(crate) fn run(args: BootArgs) -> ExitCode {
     let timeout = args.timeout.unwrap_or_else(|| default_timeout(&plan));
     drop(err);
     let outcome = if args.simulate {
-        simulate::boot(&network, &plan, &[], timeout)
+        match simulate::simulation(&network, &args.faults) {
+            Ok((bus, time)) => simulate::boot(bus, &time, &plan, timeout),
+            Err(message) => return usage(&message),
+        }
     } else {
         let iface = args.iface.as_deref().unwrap_or_default();
         crate::live::bus::open_socketcan(iface)

@@ -30,6 +30,18 @@ pub fn parse(text: &str, network: &Network) -> Result<NodeFault, String> {
     Ok(NodeFault::new(node, fault))
 }
 
+/// Every `--fault` of `texts` parsed against `network`, and checked to
+/// fit it ([`Network::check`]); `eds2rust sim --network` and `eds2rust
+/// net boot --simulate` take them so.
+pub fn parse_all(texts: &[String], network: &Network) -> Result<Vec<NodeFault>, String> {
+    let faults = texts
+        .iter()
+        .map(|text| parse(text, network))
+        .collect::<Result<Vec<_>, _>>()?;
+    network.check(&faults).map_err(|e| e.to_string())?;
+    Ok(faults)
+}
+
 /// A node id (1 to 127, decimal or 0x hex) or a slave's name.
 fn node_of(text: &str, network: &Network) -> Result<NodeId, String> {
     if let Some(node) = network.node_named(text) {

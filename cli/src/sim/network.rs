@@ -54,13 +54,7 @@ pub fn run(args: &SimArgs, bus_file: &Path) -> ExitCode {
 
 /// The `--fault` arguments, parsed against `network`.
 pub fn faults(args: &SimArgs, network: &Network) -> Result<Vec<NodeFault>, String> {
-    let faults = args
-        .faults
-        .iter()
-        .map(|text| fault::parse(text, network))
-        .collect::<Result<Vec<_>, _>>()?;
-    network.check(&faults).map_err(|e| e.to_string())?;
-    Ok(faults)
+    fault::parse_all(&args.faults, network)
 }
 
 /// Simulates `network` with `faults` on `bus` until `stop` is set or

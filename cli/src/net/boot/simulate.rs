@@ -1,28 +1,30 @@
 //! `net boot --simulate`: the network's own simulation
 //! (`eds2rust_sim::network`: every slave from its device file, at its node
-//! id, with the generic CiA 402 drive where the device is a drive) behind
-//! the master's bus in this process (`InlineBus`), in virtual time: a
-//! manual clock the simulation moves, so the boot takes as long as the
-//! CPU needs and the times shown are the simulated ones.
+//! id, with the generic CiA 402 drive where the device is a drive, and the
+//! `--fault`s of `eds2rust sim --network`) behind the master's bus in this
+//! process (`InlineBus`), in virtual time: a manual clock the simulation
+//! moves, so the boot takes as long as the CPU needs and the times shown
+//! are the simulated ones.
 
 use std::io::Write;
 use std::time::Duration;
 
 use eds2rust_runtime::boot::NetworkPlan;
 use eds2rust_runtime::transport::ManualClock;
-use eds2rust_sim::network::{InlineBus, Network, NodeFault};
+use eds2rust_sim::network::{InlineBus, Network, Simulation};
 
 use super::Outcome;
 use crate::net::load;
 
-/// Boots `plan` against the simulation of `network` with `faults`.
-pub(crate) fn boot(
+/// The simulation of `network` with the faults of `fault_texts`
+/// (`NODE:KIND[=VALUE]`), on a manual clock; `Err` with the usage error
+/// of a fault that does not parse or fit.
+pub(crate) fn simulation(
     network: &load::Network,
-    plan: &NetworkPlan,
-    faults: &[NodeFault],
-    timeout: Duration,
-) -> Result<Outcome, String> {
+    fault_texts: &[String],
+) -> Result<(InlineBus<Simulation>, ManualClock), String> {
     let simulated = Network::from_bus(&network.bus, &network.configured);
+    let faults = crate::sim::fault::parse_all(fault_texts, &simulated)?;
     if !simulated.warnings.is_empty() {
         let mut err = std::io::stderr().lock();
         for warning in &simulated.warnings {
@@ -31,9 +33,18 @@ pub(crate) fn boot(
     }
     let time = ManualClock::new();
     let simulation = simulated
-        .simulation(faults, time.now())
+        .simulation(&faults, time.now())
         .map_err(|e| e.to_string())?;
-    let bus = InlineBus::manual(simulation, time.clone());
+    Ok((InlineBus::manual(simulation, time.clone()), time))
+}
+
+/// Boots `plan` on `bus`, the simulation on `time`.
+pub(crate) fn boot(
+    bus: InlineBus<Simulation>,
+    time: &ManualClock,
+    plan: &NetworkPlan,
+    timeout: Duration,
+) -> Result<Outcome, String> {
     let mut outcome = super::boot(bus, time.clock(), plan, timeout)?;
     outcome.simulated = true;
     Ok(outcome)
