@@ -218,3 +218,80 @@ fn usage_and_input_errors() {
     assert_eq!(code, 1, "{stderr}");
     assert!(stderr.contains("eds2rust-none0"), "{stderr}");
 }
+
+/// `--run`: the network kept running after its boot; a slave that loses
+/// power is lost (E), booted again when it is back and started, one line
+/// each; the end is all operational: exit status 0.
+#[test]
+fn run_keeps_the_network_and_boots_a_returning_slave_again() {
+    let (code, stdout, stderr) = run(&[
+        "net",
+        "boot",
+        "--simulate",
+        "--fault",
+        "left:power-loss=1s+300ms",
+        "--run",
+        "2s",
+        "tests/networks/boot/bus.yml",
+    ]);
+    assert_eq!(code, 0, "{stdout}{stderr}");
+    let after: Vec<&str> = stdout
+        .lines()
+        .skip_while(|l| !l.contains("2 of 2 slaves operational in"))
+        .skip(1)
+        .collect();
+    let texts: Vec<&str> = after
+        .iter()
+        .map(|l| l.split_once(" s  ").map_or(*l, |(_, t)| t))
+        .collect();
+    assert_eq!(
+        texts,
+        [
+            "left (node 2): lost: E: no heartbeat came from the node",
+            "left (node 2): booting again",
+            "left (node 2): booted",
+            "left (node 2): started",
+            "tests/networks/boot/bus.yml: 2 of 2 slaves operational after 2.000 s of running (simulated time)",
+        ],
+        "{stdout}"
+    );
+    assert!(stderr.contains("running the network for 2.0 s"), "{stderr}");
+
+    let (code, stdout, _) = run(&[
+        "net",
+        "boot",
+        "--simulate",
+        "--fault",
+        "left:power-loss=1s+300ms",
+        "--run",
+        "2s",
+        "--format",
+        "json",
+        "tests/networks/boot/bus.yml",
+    ]);
+    assert_eq!(code, 0, "{stdout}");
+    let v: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON object");
+    let events: Vec<&str> = v["events"]
+        .as_array()
+        .expect("events")
+        .iter()
+        .map(|e| e["event"].as_str().unwrap())
+        .collect();
+    assert_eq!(events, ["lost", "rebooting", "booted", "started"]);
+    assert_eq!(v["slaves"][0]["boots"], 2);
+    assert_eq!(v["ran_seconds"], 2.0);
+
+    // With --simulate --run needs a time.
+    assert_eq!(
+        run(&[
+            "net",
+            "boot",
+            "--simulate",
+            "--run",
+            "--",
+            "tests/networks/boot/bus.yml"
+        ])
+        .0,
+        2
+    );
+}

@@ -12,6 +12,7 @@
 //! errors, 2 on usage errors.
 
 mod report;
+mod run;
 mod simulate;
 
 use std::io::Write;
@@ -28,7 +29,7 @@ use eds2rust_runtime::transport::{Bus, Clock};
 use crate::ReadArgs;
 use crate::live::bus::LiveBus;
 
-pub(crate) use report::{Outcome, render_json, render_text};
+pub(crate) use report::{Outcome, render_json, render_summary, render_text};
 
 /// Output forms.
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -74,6 +75,14 @@ pub(crate) struct BootArgs {
     /// 20 ms per SDO step of the longest boot.
     #[arg(long, value_name = "SECONDS", value_parser = crate::monitor::parse_seconds)]
     timeout: Option<Duration>,
+    /// After the boot, keep the network running for this time (seconds:
+    /// 2, 0.5, or 500ms, 2s, 1m; without a time, until Ctrl-C): the
+    /// master's heartbeat, SYNC and supervision go on, a slave that resets
+    /// or comes back is booted again; each such event is one line. The exit
+    /// status is then that of the end. With --simulate a time is needed
+    /// (the simulation runs in virtual time).
+    #[arg(long, value_name = "SECONDS", value_parser = crate::monitor::parse_seconds)]
+    run: Option<Option<Duration>>,
     #[arg(long, value_enum, default_value_t = BootFormat::Text)]
     format: BootFormat,
     /// The bus file (bus.yml).
@@ -100,36 +109,75 @@ pub(crate) fn run(args: BootArgs) -> ExitCode {
     let mut err = std::io::stderr().lock();
     let _ = write!(err, "{}", network.warnings.render());
     let plan = eds2rust::network::boot_plan(&network.bus, &network.configured);
-    let timeout = args.timeout.unwrap_or_else(|| default_timeout(&plan));
     drop(err);
-    let outcome = if args.simulate {
+    if args.simulate {
+        if args.run == Some(None) {
+            return usage(
+                "--run needs a time with --simulate (the simulation runs in virtual time): --run 10s",
+            );
+        }
         match simulate::simulation(&network, &args.faults) {
-            Ok((bus, time)) => simulate::boot(bus, &time, &plan, timeout),
-            Err(message) => return usage(&message),
+            Ok((bus, time)) => go(&args, &plan, bus, time.clock(), true),
+            Err(message) => usage(&message),
         }
     } else {
         let iface = args.iface.as_deref().unwrap_or_default();
-        crate::live::bus::open_socketcan(iface)
-            .and_then(|bus| boot(LiveBus::new(bus), Clock::new(), &plan, timeout))
-    };
-    finish(&args, &plan, outcome)
+        match crate::live::bus::open_socketcan(iface) {
+            Ok(bus) => go(&args, &plan, LiveBus::new(bus), Clock::new(), false),
+            Err(message) => failed(&message),
+        }
+    }
 }
 
-/// Prints the outcome in `args.format`; the exit status.
-fn finish(args: &BootArgs, plan: &NetworkPlan, outcome: Result<Outcome, String>) -> ExitCode {
-    let outcome = match outcome {
-        Ok(outcome) => outcome,
-        Err(message) => {
-            let _ = writeln!(std::io::stderr().lock(), "error: {message}");
-            return ExitCode::from(1);
-        }
+/// Boots on `bus`, runs on with `--run`, prints; the exit status.
+fn go<B: Bus>(
+    args: &BootArgs,
+    plan: &NetworkPlan,
+    bus: B,
+    clock: Clock,
+    simulated: bool,
+) -> ExitCode {
+    let timeout = args.timeout.unwrap_or_else(|| default_timeout(plan));
+    let (mut m, mut outcome) = match boot(bus, clock, plan, timeout) {
+        Ok(booted) => booted,
+        Err(message) => return failed(&message),
     };
+    outcome.simulated = simulated;
     let name = args.bus.display().to_string();
-    let text = match args.format {
-        BootFormat::Text => render_text(&name, plan, &outcome),
-        BootFormat::Json => render_json(&name, plan, &outcome),
+    let Some(duration) = args.run else {
+        let text = match args.format {
+            BootFormat::Text => render_text(&name, plan, &outcome),
+            BootFormat::Json => render_json(&name, plan, &outcome, &[]),
+        };
+        return exit(&text, plan, &outcome);
     };
-    if let Err(code) = crate::print(&text) {
+    if args.format == BootFormat::Text
+        && let Err(code) = crate::print(&render_text(&name, plan, &outcome))
+    {
+        return code;
+    }
+    let mut err = std::io::stderr();
+    let stop = crate::monitor::stop_on_ctrl_c("net boot --run", &mut err);
+    let until = match duration {
+        Some(d) => format!("for {:.1} s", d.as_secs_f64()),
+        None => "until Ctrl-C".into(),
+    };
+    let _ = writeln!(err, "net boot: running the network {until}");
+    let lines = args.format == BootFormat::Text;
+    let events = match run::supervise(&mut m, plan, &mut outcome, duration, &stop, lines) {
+        Ok(events) => events,
+        Err(message) => return failed(&message),
+    };
+    let text = match args.format {
+        BootFormat::Text => render_summary(&name, plan, &outcome),
+        BootFormat::Json => render_json(&name, plan, &outcome, &events),
+    };
+    exit(&text, plan, &outcome)
+}
+
+/// Prints `text`; 0 when the network runs, else 1.
+fn exit(text: &str, plan: &NetworkPlan, outcome: &Outcome) -> ExitCode {
+    if let Err(code) = crate::print(text) {
         return code;
     }
     if outcome.running(plan) {
@@ -137,6 +185,11 @@ fn finish(args: &BootArgs, plan: &NetworkPlan, outcome: Result<Outcome, String>)
     } else {
         ExitCode::from(1)
     }
+}
+
+fn failed(message: &str) -> ExitCode {
+    let _ = writeln!(std::io::stderr().lock(), "error: {message}");
+    ExitCode::from(1)
 }
 
 /// The default `--timeout` (see [`BootArgs::timeout`]): the core's own
@@ -169,7 +222,7 @@ pub(crate) fn boot<B: Bus>(
     clock: Clock,
     plan: &NetworkPlan,
     timeout: Duration,
-) -> Result<Outcome, String> {
+) -> Result<(blocking::Master<B>, Outcome), String> {
     let core = master::Master::for_network(plan).map_err(|e| e.to_string())?;
     let mut m = blocking::Master::with_clock(bus, core, clock);
     m.start().map_err(|e| e.to_string())?;
@@ -191,14 +244,16 @@ pub(crate) fn boot<B: Bus>(
         Err(e) => return Err(e.to_string()),
     };
     flushed.map_err(|e| e.to_string())?;
-    Ok(Outcome {
+    let outcome = Outcome {
         decided,
         slaves,
         started,
         ended,
         timeout,
         simulated: false,
-    })
+        ran: None,
+    };
+    Ok((m, outcome))
 }
 
 fn usage(message: &str) -> ExitCode {

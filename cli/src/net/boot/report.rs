@@ -9,6 +9,8 @@ use eds2rust_runtime::Instant;
 use eds2rust_runtime::boot::{BootStatus, Configuration, NetworkPlan, SlaveState, SlaveStatus};
 use serde_json::{Value, json};
 
+use super::run::Happening;
+
 /// The column titles.
 pub const HEADER: [&str; 8] = [
     "node",
@@ -36,6 +38,9 @@ pub(crate) struct Outcome {
     pub timeout: Duration,
     /// The bus was the network's simulation, in virtual time.
     pub simulated: bool,
+    /// With `--run`: how long the network ran after its boot (`ended` is
+    /// then the end of that, the slaves' states are those at the end).
+    pub ran: Option<Duration>,
 }
 
 impl Outcome {
@@ -185,8 +190,12 @@ fn summary(bus: &str, plan: &NetworkPlan, outcome: &Outcome) -> String {
             } else {
                 "booted"
             };
+            let when = match outcome.ran {
+                Some(ran) => format!("after {:.3} s of running", ran.as_secs_f64()),
+                None => format!("in {seconds:.3} s"),
+            };
             let mut line = format!(
-                "{bus}: {up} of {} slaves {what} in {seconds:.3} s{}",
+                "{bus}: {up} of {} slaves {what} {when}{}",
                 outcome.slaves.len(),
                 if outcome.simulated {
                     " (simulated time)"
@@ -201,6 +210,12 @@ fn summary(bus: &str, plan: &NetworkPlan, outcome: &Outcome) -> String {
             line
         }
     }
+}
+
+/// The summary line alone.
+pub(crate) fn render_summary(bus: &str, plan: &NetworkPlan, outcome: &Outcome) -> String {
+    let text = format!("{}\n", summary(bus, plan, outcome));
+    eds2rust::text::terminal(&text).into_owned()
 }
 
 /// The table and the summary line.
@@ -234,14 +249,25 @@ pub(crate) fn render_text(bus: &str, plan: &NetworkPlan, outcome: &Outcome) -> S
     eds2rust::text::terminal(&text).into_owned()
 }
 
-/// The outcome as one JSON object (and a newline).
-pub(crate) fn render_json(bus: &str, plan: &NetworkPlan, outcome: &Outcome) -> String {
+/// Seconds to the microsecond the times are kept in (no binary tails).
+fn secs(seconds: f64) -> f64 {
+    (seconds * 1e6).round() / 1e6
+}
+
+/// The outcome as one JSON object (and a newline), with what happened
+/// while the network ran (`--run`).
+pub(crate) fn render_json(
+    bus: &str,
+    plan: &NetworkPlan,
+    outcome: &Outcome,
+    happenings: &[Happening],
+) -> String {
     let slaves: Vec<Value> = outcome
         .slaves
         .iter()
         .map(|s| {
             let (seconds, done) =
-                taken(outcome, s).map_or((None, false), |(t, d)| (Some(t.as_secs_f64()), d));
+                taken(outcome, s).map_or((None, false), |(t, d)| (Some(secs(t.as_secs_f64())), d));
             json!({
                 "node": s.node.get(),
                 "name": s.name,
@@ -272,11 +298,27 @@ pub(crate) fn render_json(bus: &str, plan: &NetworkPlan, outcome: &Outcome) -> S
         "bus": bus,
         "running": outcome.running(plan),
         "decided": outcome.decided,
-        "seconds": (outcome.ended - outcome.started).as_secs_f64(),
+        "seconds": secs((outcome.ended - outcome.started).as_secs_f64()),
         "simulated": outcome.simulated,
         "summary": summary(bus, plan, outcome),
         "slaves": slaves,
     });
+    let mut value = value;
+    if let Some(ran) = outcome.ran {
+        value["ran_seconds"] = json!(secs(ran.as_secs_f64()));
+        value["events"] = happenings
+            .iter()
+            .map(|h| {
+                json!({
+                    "seconds": secs(h.seconds),
+                    "node": h.node,
+                    "name": h.name,
+                    "event": h.kind,
+                    "text": h.text,
+                })
+            })
+            .collect();
+    }
     let mut text = serde_json::to_string_pretty(&value).unwrap_or_default();
     text.push('\n');
     text

@@ -6,14 +6,10 @@
 //! moves, so the boot takes as long as the CPU needs and the times shown
 //! are the simulated ones.
 
-use std::io::Write;
-use std::time::Duration;
-
-use eds2rust_runtime::boot::NetworkPlan;
 use eds2rust_runtime::transport::ManualClock;
 use eds2rust_sim::network::{InlineBus, Network, Simulation};
+use std::io::Write;
 
-use super::Outcome;
 use crate::net::load;
 
 /// The simulation of `network` with the faults of `fault_texts`
@@ -36,16 +32,4 @@ pub(crate) fn simulation(
         .simulation(&faults, time.now())
         .map_err(|e| e.to_string())?;
     Ok((InlineBus::manual(simulation, time.clone()), time))
-}
-
-/// Boots `plan` on `bus`, the simulation on `time`.
-pub(crate) fn boot(
-    bus: InlineBus<Simulation>,
-    time: &ManualClock,
-    plan: &NetworkPlan,
-    timeout: Duration,
-) -> Result<Outcome, String> {
-    let mut outcome = super::boot(bus, time.clock(), plan, timeout)?;
-    outcome.simulated = true;
-    Ok(outcome)
 }

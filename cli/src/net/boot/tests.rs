@@ -26,7 +26,7 @@ fn an_empty_bus_fails_every_slave_with_status_b() {
     plan.response_time = Duration::from_millis(50);
     plan.boot_time = None;
     let bus = VirtualBus::new();
-    let outcome =
+    let (_, outcome) =
         boot(bus.attach(), Clock::new(), &plan, Duration::from_secs(5)).expect("the boot runs");
     assert_eq!(
         outcome.decided,
