@@ -421,4 +421,6 @@ pub fn run(args: MonitorArgs) -> ExitCode {
 }
 
 #[cfg(test)]
+mod bus_tests;
+#[cfg(test)]
 mod tests;

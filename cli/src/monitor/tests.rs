@@ -176,62 +176,6 @@ fn nodes_are_rows_from_the_start_and_when_heard() {
     assert!(table.render(1.0, true).contains("TPDO1: "));
 }
 
-/// With the seed machine's bus file, the Zimmer axis (node 40) sends TPDO2
-/// as the network remaps it (velocity and torque), not as its file's
-/// default (velocity only); every slave is a row from the start.
-#[test]
-fn a_bus_file_gives_the_nodes_and_the_pdos_the_network_configures() {
-    let bus = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../eds/machine/bus.yml");
-    let files = NodeFiles {
-        nodes: Vec::new(),
-        overlays: Vec::new(),
-        bus: Some(bus),
-    };
-    let decoder = files
-        .decoder()
-        .unwrap_or_else(|_| panic!("the machine's bus file has errors"));
-    let nodes: Vec<u8> = (1..=127)
-        .filter(|&n| decoder.dictionary(n).is_some())
-        .collect();
-    assert_eq!(nodes, [5, 32, 40]);
-    let mut m = Monitor::new(decoder, &nodes, None, Vec::new()).with_format(OutFormat::Json, false);
-    // Velocity 1000 mm/s, torque -5 % of the rated torque.
-    let tpdo2 = frame(0x2A8, &[0xE8, 0x03, 0x00, 0x00, 0xFB, 0xFF]);
-    let out = feed(&mut m, &[(0.1, tpdo2)]);
-    let line: serde_json::Value = serde_json::from_str(out.trim()).unwrap();
-    assert_eq!(line["node"], 40, "{out}");
-    assert_eq!(line["pdo"], "tpdo2", "{out}");
-    let names: Vec<&str> = line["fields"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|f| f["name"].as_str().unwrap())
-        .collect();
-    assert_eq!(
-        names,
-        ["Velocity actual value", "Torque actual value"],
-        "{out}"
-    );
-    assert_eq!(line["fields"][1]["raw"], -5, "{out}");
-
-    let mut table = Monitor::new(
-        NodeFiles {
-            nodes: Vec::new(),
-            overlays: Vec::new(),
-            bus: files.bus.clone(),
-        }
-        .decoder()
-        .unwrap_or_else(|_| panic!("the bus file has errors")),
-        &nodes,
-        Some(View::Plain),
-        Vec::new(),
-    );
-    let text = table.table.as_mut().unwrap().render(0.0, true);
-    for node in nodes {
-        row_of(&text, node);
-    }
-}
-
 #[test]
 fn the_record_stream_is_the_decoders_with_the_monitors_time() {
     let mut m = monitor(None, &[]).with_format(OutFormat::Json, false);

@@ -13,7 +13,7 @@
 
 mod report;
 mod run;
-mod simulate;
+pub(crate) mod simulate;
 
 use std::io::Write;
 use std::path::PathBuf;

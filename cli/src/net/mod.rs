@@ -1,7 +1,7 @@
 //! `eds2rust net`: commands on a whole network, described by a bus file
 //! (lely dcfgen's YAML, as ros2_canopen users write it).
 
-mod boot;
+pub(crate) mod boot;
 mod check;
 mod dcf;
 pub(crate) mod load;
