@@ -118,12 +118,7 @@ fn the_booted_machines_trace_decodes_by_the_networks_names() {
         .bus()
         .trace()
         .iter()
-        .map(|(t, f)| {
-            (
-                (*t - eds2rust_runtime::Instant::ZERO).as_secs_f64(),
-                f.clone(),
-            )
-        })
+        .map(|(t, f)| ((*t - eds2rust_runtime::Instant::ZERO).as_secs_f64(), *f))
         .collect();
 
     let decoder = bus_files()
