@@ -39,6 +39,42 @@ fn an_empty_bus_fails_every_slave_with_status_b() {
             .all(|s| s.error.as_ref().is_some_and(|e| e.status.letter() == 'B'))
     );
     let text = render_text("bus.yml", &plan, &outcome);
-    println!("{text}");
     assert!(text.contains("boot error B"), "{text}");
+}
+
+/// The `--iface` path's boot on the real clock: the seed machine's own
+/// simulation served in a thread on one port of a virtual bus (as `eds2rust
+/// sim --network` serves it on an interface), the master on another.
+#[test]
+fn the_seed_machine_boots_on_the_real_clock_against_its_simulation_in_a_thread() {
+    use std::sync::Arc;
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    use eds2rust_runtime::Service;
+
+    let network = crate::net::load::read_configured(&machine(), &Options::default(), "booted")
+        .expect("the bus file reads");
+    let plan = eds2rust::network::boot_plan(&network.bus, &network.configured);
+    let simulated = eds2rust_sim::network::Network::from_bus(&network.bus, &network.configured);
+    let bus = VirtualBus::new();
+    let clock = Clock::new();
+    let mut port = bus.attach();
+    let mut sim = simulated.simulation(&[], clock.now()).expect("no faults");
+    while let Some(frame) = sim.poll_transmit() {
+        port.send(&frame).unwrap();
+    }
+    let stop = Arc::new(AtomicBool::new(false));
+    let flag = Arc::clone(&stop);
+    let serve_clock = clock.clone();
+    let thread = std::thread::spawn(move || {
+        eds2rust_runtime::blocking::serve(&mut port, &serve_clock, &mut sim, &flag, None, |_| {})
+    });
+    let result = boot(bus.attach(), clock, &plan, default_timeout(&plan));
+    stop.store(true, Ordering::Relaxed);
+    thread.join().unwrap().unwrap();
+    let (_, outcome) = result.expect("the boot runs");
+    let text = render_text("bus.yml", &plan, &outcome);
+    assert!(outcome.running(&plan), "{text}");
+    assert!(text.contains("3 of 3 slaves operational in"), "{text}");
+    assert!(!text.contains("simulated time"), "{text}");
 }
