@@ -165,7 +165,7 @@ fn summary(bus: &str, plan: &NetworkPlan, outcome: &Outcome) -> String {
     };
     match outcome.decided {
         None => format!(
-            "{bus}: the boot was not decided within {:.1} s; not booted: {}",
+            "{bus}: the boot was not decided within {:.3} s; not booted: {}",
             outcome.timeout.as_secs_f64(),
             list(&failed.iter().collect::<Vec<_>>())
         ),

@@ -78,3 +78,27 @@ fn the_seed_machine_boots_on_the_real_clock_against_its_simulation_in_a_thread()
     assert!(text.contains("3 of 3 slaves operational in"), "{text}");
     assert!(!text.contains("simulated time"), "{text}");
 }
+
+/// A boot not decided within the timeout: every slave still booting (its
+/// time so far), the summary names them; not running.
+#[test]
+fn a_boot_not_decided_in_time_lists_the_slaves_still_booting() {
+    let mut plan = plan(&machine());
+    plan.response_time = Duration::from_secs(10);
+    plan.boot_time = None;
+    let bus = VirtualBus::new();
+    let (_, outcome) =
+        boot(bus.attach(), Clock::new(), &plan, Duration::from_millis(30)).expect("the boot runs");
+    assert_eq!(outcome.decided, None);
+    assert!(!outcome.running(&plan));
+    let text = render_text("bus.yml", &plan, &outcome);
+    assert!(text.contains("| booting "), "{text}");
+    assert!(text.contains("> 0.0"), "{text}");
+    assert!(
+        text.ends_with(
+            "bus.yml: the boot was not decided within 0.030 s; not booted: conveyor (node 5) \
+             booting, actuator (node 32) booting, axis (node 40) booting\n"
+        ),
+        "{text}"
+    );
+}
