@@ -76,6 +76,12 @@ impl NodeFiles {
     /// (`eds2rust::network::configured::configured_device`, as the
     /// generated network and `api` of a bus file have it).
     pub fn decoder(&self) -> Result<Decoder, ExitCode> {
+        self.decoder_named().map(|(decoder, _)| decoder)
+    }
+
+    /// [`NodeFiles::decoder`], with the names of the nodes a bus file
+    /// names (none with `--node`).
+    pub fn decoder_named(&self) -> Result<(Decoder, Vec<(u8, String)>), ExitCode> {
         if let Some(path) = &self.bus {
             return bus_decoder(path);
         }
@@ -118,24 +124,27 @@ impl NodeFiles {
                 }
             }
         }
-        Ok(decoder)
+        Ok((decoder, Vec::new()))
     }
 }
 
-/// The decoder of a bus file's network (see [`NodeFiles::decoder`]).
-fn bus_decoder(path: &std::path::Path) -> Result<Decoder, ExitCode> {
+/// The decoder of a bus file's network (see [`NodeFiles::decoder`]) and
+/// its slaves' names.
+fn bus_decoder(path: &std::path::Path) -> Result<(Decoder, Vec<(u8, String)>), ExitCode> {
     let network = crate::net::load::read_configured(path, &Options::default(), "used")
         .ok_or(ExitCode::from(1))?;
     let _ = write!(io::stderr().lock(), "{}", network.warnings.render());
     let mut decoder = Decoder::new();
+    let mut names = Vec::new();
     for node in &network.configured.nodes {
         let Some(slave) = network.bus.slaves.get(node.slave) else {
             continue;
         };
         let device = eds2rust::network::configured::configured_device(&slave.device, node);
         decoder.add_node(node.node_id, Arc::new(device));
+        names.push((node.node_id, node.name.clone()));
     }
-    Ok(decoder)
+    Ok((decoder, names))
 }
 
 /// Writes one record in `format`. Text is one terminal-safe line: names

@@ -192,6 +192,14 @@ impl Monitor {
         self
     }
 
+    /// Names the table's nodes (a bus file's slaves).
+    pub fn with_names(mut self, names: Vec<(u8, String)>) -> Monitor {
+        if let Some(table) = &mut self.table {
+            table.names = names.into_iter().collect();
+        }
+        self
+    }
+
     /// Receives and decodes frames from `bus` until `duration` has passed
     /// (forever without one) or `stop` is set, writing to `out` the record
     /// stream or the table; the table once more at the end.
@@ -363,7 +371,7 @@ impl Monitor {
 /// the interface cannot be opened or failed, a file has errors, the chart
 /// failed or a field was never seen, 2 usage errors.
 pub fn run(args: MonitorArgs) -> ExitCode {
-    let decoder = match args.files.decoder() {
+    let (decoder, names) = match args.files.decoder_named() {
         Ok(d) => d,
         Err(code) => return code,
     };
@@ -386,6 +394,7 @@ pub fn run(args: MonitorArgs) -> ExitCode {
         .collect();
     let mut monitor = Monitor::new(decoder, &nodes, view, args.plot.clone())
         .with_format(args.format, args.unix_time)
+        .with_names(names)
         .with_title(format!("eds2rust monitor {}", args.iface));
     let until = match args.duration {
         Some(d) => format!("for {:.1} s", d.as_secs_f64()),

@@ -27,13 +27,10 @@ fn frame(id: u16, data: &[u8]) -> Frame {
     Frame::new(CanId::Standard(id), data).unwrap()
 }
 
-/// The line of `text` (a plain table) whose first cell is `node`.
-fn has_row(text: &str, node: u8) -> bool {
-    text.lines().any(|l| {
-        l.split('|')
-            .nth(1)
-            .is_some_and(|c| c.trim() == node.to_string())
-    })
+/// Whether `text` (a plain table) has a line whose first cell is `first`.
+fn has_row(text: &str, first: &str) -> bool {
+    text.lines()
+        .any(|l| l.split('|').nth(1).is_some_and(|c| c.trim() == first))
 }
 
 /// The names of a JSON record's PDO fields.
@@ -46,7 +43,7 @@ fn field_names(record: &serde_json::Value) -> Vec<&str> {
 
 /// With the seed machine's bus file, the Zimmer axis (node 40) sends TPDO2
 /// as the network remaps it (velocity and torque), not as its file's
-/// default (velocity only); every slave is a row from the start.
+/// default (velocity only); every slave is a row from the start, named.
 #[test]
 fn a_bus_file_gives_the_nodes_and_the_pdos_the_network_configures() {
     let files = bus_files();
@@ -79,17 +76,13 @@ fn a_bus_file_gives_the_nodes_and_the_pdos_the_network_configures() {
     );
     assert_eq!(line["fields"][1]["raw"], -5, "{out}");
 
-    let mut table = Monitor::new(
-        bus_files()
-            .decoder()
-            .unwrap_or_else(|_| panic!("the bus file has errors")),
-        &nodes,
-        Some(View::Plain),
-        Vec::new(),
-    );
+    let (decoder, names) = bus_files()
+        .decoder_named()
+        .unwrap_or_else(|_| panic!("the bus file has errors"));
+    let mut table = Monitor::new(decoder, &nodes, Some(View::Plain), Vec::new()).with_names(names);
     let text = table.table.as_mut().unwrap().render(0.0, true);
-    for node in nodes {
-        assert!(has_row(&text, node), "{text}");
+    for row in ["5 conveyor", "32 actuator", "40 axis"] {
+        assert!(has_row(&text, row), "{text}");
     }
 }
 
