@@ -295,3 +295,42 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
         2
     );
 }
+
+/// The blocks of docs/network.md's `## net boot` marked `<!-- output:
+/// NAME -->` are the command on their first line (`$ eds2rust ...`) and
+/// its real output; `UPDATE_DOCS=1` rewrites them instead.
+#[test]
+fn the_docs_show_the_real_output() {
+    let path = root().join("docs/network.md");
+    let mut doc = std::fs::read_to_string(&path).expect("docs/network.md");
+    for name in ["net-boot-simulate", "net-boot-fault"] {
+        let marker = format!("<!-- output: {name} -->\n```text\n");
+        let start = doc
+            .find(&marker)
+            .unwrap_or_else(|| panic!("no {marker:?} in docs/network.md"))
+            + marker.len();
+        let end = start + doc[start..].find("```\n").expect("the block's end");
+        let block = &doc[start..end];
+        let command = block
+            .lines()
+            .next()
+            .and_then(|l| l.strip_prefix("$ eds2rust "))
+            .unwrap_or_else(|| panic!("block {name} does not start with `$ eds2rust `"));
+        let args: Vec<&str> = command.split_whitespace().collect();
+        let (_, stdout, stderr) = run(&args);
+        assert!(stderr.is_empty(), "{stderr}");
+        let real = format!("$ eds2rust {command}\n{stdout}");
+        if std::env::var_os("UPDATE_DOCS").is_some() {
+            doc = format!("{}{real}{}", &doc[..start], &doc[end..]);
+            continue;
+        }
+        assert_eq!(
+            block, real,
+            "docs/network.md block {name} does not show the real output; run with \
+             UPDATE_DOCS=1 and review"
+        );
+    }
+    if std::env::var_os("UPDATE_DOCS").is_some() {
+        std::fs::write(&path, doc).unwrap();
+    }
+}
