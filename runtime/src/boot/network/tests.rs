@@ -110,6 +110,19 @@ fn a_second_boot_up_during_the_device_type_read_keeps_the_read() {
     assert_eq!(boot.slave(id(5)).unwrap().boots, 1);
 }
 
+/// Slave 5 answers 0x1000 and takes its one configuration write at `at`.
+fn identify_and_configure(boot: &mut NetworkBoot, at: Instant) {
+    boot.handle_frame(at, &boot_up(5));
+    assert_eq!(actions(boot), [read(5, 0x1000, 0)]);
+    boot.sdo_event(at, id(5), &uploaded(0x1000, 0, 0x192));
+    actions(boot);
+    let done = ClientEvent::Downloaded {
+        index: 0x1017,
+        sub: 0,
+    };
+    assert!(boot.sdo_event(at, id(5), &done));
+}
+
 #[test]
 fn the_wait_for_the_first_heartbeat_ends_with_the_boot_time() {
     let mut config = slave(5, true);
@@ -121,16 +134,7 @@ fn the_wait_for_the_first_heartbeat_ends_with_the_boot_time() {
     boot.start(Instant::ZERO);
     actions(&mut boot);
     // The boot-up comes late, just within the boot time.
-    let late = Instant::from_millis(990);
-    boot.handle_frame(late, &boot_up(5));
-    assert_eq!(actions(&mut boot), [read(5, 0x1000, 0)]);
-    boot.sdo_event(late, id(5), &uploaded(0x1000, 0, 0x192));
-    actions(&mut boot);
-    let done = ClientEvent::Downloaded {
-        index: 0x1017,
-        sub: 0,
-    };
-    assert!(boot.sdo_event(late, id(5), &done));
+    identify_and_configure(&mut boot, Instant::from_millis(990));
     assert_eq!(
         actions(&mut boot),
         [Action::Supervise(
@@ -170,15 +174,7 @@ fn after_the_first_boot_the_heartbeat_wait_is_the_response_time() {
     assert_eq!(actions(&mut boot), [Action::MasterOperational]);
     // It comes later: booted again, with the response time to wait.
     let later = Instant::from_millis(5000);
-    boot.handle_frame(later, &boot_up(5));
-    assert_eq!(actions(&mut boot), [read(5, 0x1000, 0)]);
-    boot.sdo_event(later, id(5), &uploaded(0x1000, 0, 0x192));
-    actions(&mut boot);
-    let done = ClientEvent::Downloaded {
-        index: 0x1017,
-        sub: 0,
-    };
-    boot.sdo_event(later, id(5), &done);
+    identify_and_configure(&mut boot, later);
     assert_eq!(
         boot.poll_timeout(),
         Some(later + NetworkPlan::DEFAULT_RESPONSE_TIME)
