@@ -185,7 +185,8 @@ impl SimNode {
             }
         }
         if faults.contains(&Fault::Missing) {
-            schedule.retain(|(_, s)| !matches!(s, Step::PowerOn | Step::PowerOff));
+            // Never on the bus: nothing else happens to it.
+            schedule.clear();
         }
         if let Some(at) = power_on {
             schedule.push((at, Step::PowerOn));
