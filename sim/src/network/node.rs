@@ -208,6 +208,50 @@ impl SimNode {
         }
     }
 
+    /// Applies `fault` from `now` on (times count from `now`): power loss,
+    /// error control stop, a refused write, a late power-on of a node not
+    /// yet powered, or `Missing` (off for good). The others change what
+    /// the device holds from power-on: an error.
+    pub(super) fn inject(&mut self, now: Instant, fault: Fault) -> Result<(), &'static str> {
+        match fault {
+            Fault::Missing => {
+                self.schedule.clear();
+                self.schedule.push((now, Step::PowerOff));
+            }
+            Fault::LateBoot(d) => {
+                if self.powered || self.model.is_some() {
+                    return Err("the node was powered on already");
+                }
+                self.schedule.retain(|(_, s)| *s != Step::PowerOn);
+                self.schedule.push((now + d, Step::PowerOn));
+            }
+            Fault::PowerLoss { at, off } => {
+                self.schedule.push((now + at, Step::PowerOff));
+                self.schedule.push((now + at + off, Step::PowerOn));
+            }
+            Fault::HeartbeatStops { at, resume } => {
+                self.schedule.push((now + at, Step::HeartbeatOff));
+                if let Some(r) = resume {
+                    self.schedule.push((now + at + r, Step::HeartbeatOn));
+                }
+            }
+            Fault::SdoAbort { index, sub, code } => {
+                self.refused.push((index, sub, code));
+                if let Some(model) = self.model.as_mut() {
+                    each!(model, d => d.with_model(now, |b, _| b.refused.push((index, sub, code))));
+                }
+            }
+            Fault::Identity(..) | Fault::ConfigurationCurrent | Fault::ConfigurationDate { .. } => {
+                return Err(
+                    "it changes what the device holds from its power-on: give it to \
+                            `Network::simulation`",
+                );
+            }
+        }
+        self.schedule.sort_by_key(|(at, _)| *at);
+        Ok(())
+    }
+
     /// Has the device hold `values` saved (0x1010) from its first
     /// power-on, as a device that was configured and stored before.
     pub(super) fn set_stored(&mut self, values: Vec<(u16, u8, Vec<u8>)>) {
