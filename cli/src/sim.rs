@@ -191,16 +191,26 @@ pub fn run(args: SimArgs) -> ExitCode {
         );
         return ExitCode::from(2);
     };
-    let bus = match bus::open_socketcan(&args.iface) {
-        Ok(bus) => bus,
+    let (bus, stop) = match open(&args.iface, &mut err) {
+        Ok(opened) => opened,
+        Err(code) => return code,
+    };
+    simulate(&args, &table, node, bus, &stop, &mut io::stdout(), &mut err)
+}
+
+/// The interface `iface`, and the flag Ctrl-C sets; an error (exit 1) when
+/// it does not open, said on `err`.
+fn open(
+    iface: &str,
+    err: &mut dyn Write,
+) -> Result<(Box<dyn Bus + Send>, std::sync::Arc<AtomicBool>), ExitCode> {
+    match bus::open_socketcan(iface) {
+        Ok(bus) => Ok((bus, crate::monitor::stop_on_ctrl_c("the simulator", err))),
         Err(message) => {
             let _ = writeln!(err, "error: {message}");
-            return ExitCode::from(1);
+            Err(ExitCode::from(1))
         }
-    };
-    let stop = crate::monitor::stop_on_ctrl_c("the simulator", &mut err);
-    let mut out = io::stdout();
-    simulate(&args, &table, node, bus, &stop, &mut out, &mut err)
+    }
 }
 
 /// A file that does not read: its errors (each naming file and line),

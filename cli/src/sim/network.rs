@@ -14,8 +14,7 @@ use std::sync::atomic::AtomicBool;
 use eds2rust_runtime::transport::Bus;
 use eds2rust_sim::network::{Event, Network, NodeFault, Simulation};
 
-use super::{Labels, Runner, SimArgs, event_line, fault, not_simulated};
-use crate::live::bus;
+use super::{Labels, Runner, SimArgs, event_line, fault, not_simulated, open};
 use crate::live::od::Od;
 
 /// Runs `--network BUS`; the exit status (as `eds2rust sim FILE`).
@@ -40,16 +39,19 @@ pub fn run(args: &SimArgs, bus_file: &Path) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let bus = match bus::open_socketcan(&args.iface) {
-        Ok(bus) => bus,
-        Err(message) => {
-            let _ = writeln!(err, "error: {message}");
-            return ExitCode::from(1);
-        }
+    let (bus, stop) = match open(&args.iface, &mut err) {
+        Ok(opened) => opened,
+        Err(code) => return code,
     };
-    let stop = crate::monitor::stop_on_ctrl_c("the simulator", &mut err);
-    let mut out = io::stdout();
-    simulate(args, &network, &faults, bus, &stop, &mut out, &mut err)
+    simulate(
+        args,
+        &network,
+        &faults,
+        bus,
+        &stop,
+        &mut io::stdout(),
+        &mut err,
+    )
 }
 
 /// The `--fault` arguments, parsed against `network`.

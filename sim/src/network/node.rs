@@ -185,7 +185,8 @@ impl SimNode {
             }
         }
         if faults.contains(&Fault::Missing) {
-            schedule.retain(|(_, s)| !matches!(s, Step::PowerOn | Step::PowerOff));
+            // Never on the bus: nothing else happens to it.
+            schedule.clear();
         }
         if let Some(at) = power_on {
             schedule.push((at, Step::PowerOn));
@@ -205,6 +206,50 @@ impl SimNode {
             heartbeat_off: false,
             schedule,
         }
+    }
+
+    /// Applies `fault` from `now` on (times count from `now`): power loss,
+    /// error control stop, a refused write, a late power-on of a node not
+    /// yet powered, or `Missing` (off for good). The others change what
+    /// the device holds from power-on: an error.
+    pub(super) fn inject(&mut self, now: Instant, fault: Fault) -> Result<(), &'static str> {
+        match fault {
+            Fault::Missing => {
+                self.schedule.clear();
+                self.schedule.push((now, Step::PowerOff));
+            }
+            Fault::LateBoot(d) => {
+                if self.powered || self.model.is_some() {
+                    return Err("the node was powered on already");
+                }
+                self.schedule.retain(|(_, s)| *s != Step::PowerOn);
+                self.schedule.push((now + d, Step::PowerOn));
+            }
+            Fault::PowerLoss { at, off } => {
+                self.schedule.push((now + at, Step::PowerOff));
+                self.schedule.push((now + at + off, Step::PowerOn));
+            }
+            Fault::HeartbeatStops { at, resume } => {
+                self.schedule.push((now + at, Step::HeartbeatOff));
+                if let Some(r) = resume {
+                    self.schedule.push((now + at + r, Step::HeartbeatOn));
+                }
+            }
+            Fault::SdoAbort { index, sub, code } => {
+                self.refused.push((index, sub, code));
+                if let Some(model) = self.model.as_mut() {
+                    each!(model, d => d.with_model(now, |b, _| b.refused.push((index, sub, code))));
+                }
+            }
+            Fault::Identity(..) | Fault::ConfigurationCurrent | Fault::ConfigurationDate { .. } => {
+                return Err(
+                    "it changes what the device holds from its power-on: give it to \
+                            `Network::simulation`",
+                );
+            }
+        }
+        self.schedule.sort_by_key(|(at, _)| *at);
+        Ok(())
     }
 
     /// Has the device hold `values` saved (0x1010) from its first

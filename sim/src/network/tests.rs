@@ -211,3 +211,41 @@ fn an_inline_bus_on_the_real_clock_boots_the_machine_in_real_time() {
     let took = real.elapsed();
     assert!(took < Duration::from_secs(3), "{took:?}");
 }
+
+#[test]
+fn faults_injected_while_running_happen_from_then_on() {
+    let network = machine();
+    let mut sim = network.simulation(&[], Instant::ZERO).unwrap();
+    frames(&mut sim);
+    let now = Instant::from_millis(500);
+    let loss = Fault::PowerLoss {
+        at: Duration::ZERO,
+        off: Duration::from_millis(100),
+    };
+    sim.inject(NodeFault::new(node(40), loss), now).unwrap();
+    assert!(!sim.is_powered(node(40)));
+    assert_eq!(
+        sim.poll_timeout().map(|t| t <= Instant::from_millis(600)),
+        Some(true)
+    );
+    let back = Instant::from_millis(600);
+    while sim.poll_timeout().is_some_and(|t| t <= back) {
+        let t = sim.poll_timeout().unwrap();
+        sim.handle_timeout(t);
+        frames(&mut sim);
+    }
+    assert!(sim.is_powered(node(40)));
+    let events: Vec<Event> = std::iter::from_fn(|| sim.poll_event()).collect();
+    assert!(events.contains(&Event::PoweredOff(node(40))));
+    assert!(events.contains(&Event::PoweredOn(node(40))));
+    // What the device holds from power-on is no fault to inject.
+    let wrong = Fault::Identity(IdentityField::VendorId, 1);
+    let error = sim
+        .inject(NodeFault::new(node(40), wrong), back)
+        .unwrap_err();
+    assert!(error.to_string().contains("Network::simulation"), "{error}");
+    let error = sim
+        .inject(NodeFault::new(node(9), Fault::Missing), back)
+        .unwrap_err();
+    assert!(error.to_string().contains("no node 9"), "{error}");
+}
