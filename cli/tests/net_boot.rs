@@ -231,6 +231,7 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
         "--fault",
         "left:power-loss=1s+300ms",
         "--run",
+        "--duration",
         "2s",
         "tests/networks/boot/bus.yml",
     ]);
@@ -264,6 +265,7 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
         "--fault",
         "left:power-loss=1s+300ms",
         "--run",
+        "--duration",
         "2s",
         "--format",
         "json",
@@ -281,17 +283,11 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
     assert_eq!(v["slaves"][0]["boots"], 2);
     assert_eq!(v["ran_seconds"], 2.0);
 
-    // With --simulate --run needs a time.
+    // With --simulate --run needs a time; --duration needs --run.
+    let bus = "tests/networks/boot/bus.yml";
+    assert_eq!(run(&["net", "boot", "--simulate", "--run", bus]).0, 2);
     assert_eq!(
-        run(&[
-            "net",
-            "boot",
-            "--simulate",
-            "--run",
-            "--",
-            "tests/networks/boot/bus.yml"
-        ])
-        .0,
+        run(&["net", "boot", "--simulate", "--duration", "1s", bus]).0,
         2
     );
 }

@@ -84,7 +84,16 @@ fn net_boot_boots_the_simulated_seed_machine_over_vcan() {
     // Booted again and kept running, the network's TPDOs come on SYNC and
     // the monitor names their fields as the bus file maps them.
     let mut running = Running::spawn(
-        &["net", "boot", &bus, "--iface", &i, "--run", "20"],
+        &[
+            "net",
+            "boot",
+            &bus,
+            "--iface",
+            &i,
+            "--run",
+            "--duration",
+            "20",
+        ],
         "net boot: running",
     );
     running.ready();

@@ -75,14 +75,16 @@ pub(crate) struct BootArgs {
     /// 20 ms per SDO step of the longest boot.
     #[arg(long, value_name = "SECONDS", value_parser = crate::monitor::parse_seconds)]
     timeout: Option<Duration>,
-    /// After the boot, keep the network running for this time (seconds:
-    /// 2, 0.5, or 500ms, 2s, 1m; without a time, until Ctrl-C): the
-    /// master's heartbeat, SYNC and supervision go on, a slave that resets
-    /// or comes back is booted again; each such event is one line. The exit
-    /// status is then that of the end. With --simulate a time is needed
-    /// (the simulation runs in virtual time).
-    #[arg(long, value_name = "SECONDS", value_parser = crate::monitor::parse_seconds)]
-    run: Option<Option<Duration>>,
+    /// After the boot, keep the network running (until Ctrl-C, or for
+    /// --duration): the master's heartbeat, SYNC and supervision go on, a
+    /// slave that resets or comes back is booted again; each such event
+    /// is one line. The exit status is then that of the end.
+    #[arg(long)]
+    run: bool,
+    /// With --run: stop after this time (seconds: 2, 0.5, or 500ms, 2s,
+    /// 1m). Needed with --simulate (the simulation runs in virtual time).
+    #[arg(long, value_name = "SECONDS", requires = "run", value_parser = crate::monitor::parse_seconds)]
+    duration: Option<Duration>,
     #[arg(long, value_enum, default_value_t = BootFormat::Text)]
     format: BootFormat,
     /// The bus file (bus.yml).
@@ -111,9 +113,10 @@ pub(crate) fn run(args: BootArgs) -> ExitCode {
     let plan = eds2rust::network::boot_plan(&network.bus, &network.configured);
     drop(err);
     if args.simulate {
-        if args.run == Some(None) {
+        if args.run && args.duration.is_none() {
             return usage(
-                "--run needs a time with --simulate (the simulation runs in virtual time): --run 10s",
+                "--run needs --duration with --simulate (the simulation runs in virtual time): \
+                 --run --duration 10s",
             );
         }
         match simulate::simulation(&network, &args.faults) {
@@ -144,13 +147,14 @@ fn go<B: Bus>(
     };
     outcome.simulated = simulated;
     let name = args.bus.display().to_string();
-    let Some(duration) = args.run else {
+    let duration = args.duration;
+    if !args.run {
         let text = match args.format {
             BootFormat::Text => render_text(&name, plan, &outcome),
             BootFormat::Json => render_json(&name, plan, &outcome, &[]),
         };
         return exit(&text, plan, &outcome);
-    };
+    }
     if args.format == BootFormat::Text
         && let Err(code) = crate::print(&render_text(&name, plan, &outcome))
     {
