@@ -4,7 +4,10 @@
 //! name, identity check, configuration, state, time taken and, for a
 //! failure, the boot error (its status letter A–O with what it means, the
 //! object and the expected and found values). `--simulate` boots the
-//! network's own simulation in this process, on the virtual bus.
+//! network's own simulation in this process, on the virtual bus, with the
+//! `--fault`s of `eds2rust sim --network` (`simulate.rs`); `--run` keeps
+//! the network running after its boot, one line per slave event
+//! (`run.rs`); the table, the summary and the JSON are `report.rs`'s.
 //!
 //! Exit status: 0 when every mandatory slave is operational (booted, when
 //! the network does not start its slaves), 1 when one is not, the boot
