@@ -29,7 +29,8 @@ pub fn boot_plan(bus: &Bus, configured: &Configured) -> NetworkPlan {
     let master = MasterPlan {
         node: NodeId::new(m.node_id).unwrap_or(NodeId::new(1).expect("1 is a node id")),
         heartbeat: ms(u64::from(m.heartbeat_producer)),
-        sync_period: (m.sync_period != 0).then(|| Duration::from_micros(u64::from(m.sync_period))),
+        sync_period: (m.sync_period != 0)
+            .then(|| Duration::from_micros(u64::from(m.sync_period))),
         sync_overflow: m.sync_overflow,
     };
     let mut slaves = Vec::new();
