@@ -179,11 +179,15 @@ fn summary(bus: &str, plan: &NetworkPlan, outcome: &Outcome) -> String {
             format!("{bus}: the network did not boot: {}: {error}", s.name)
         }
         Some(_) if !mandatory.is_empty() => format!(
-            "{bus}: the network did not boot: {} mandatory slaves are not up: {}",
-            mandatory.len(),
+            "{bus}: the network did not boot: mandatory slaves not up: {}",
             list(&mandatory)
         ),
-        Some(_) => {
+        // Booted again since, but the network's first boot failed: the
+        // master started nothing.
+        Some(false) => {
+            format!("{bus}: the network did not boot: a mandatory slave failed its first boot")
+        }
+        Some(true) => {
             let up = outcome.slaves.len() - failed.len();
             let what = if plan.start_nodes {
                 "operational"
