@@ -283,6 +283,29 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
     assert_eq!(v["slaves"][0]["boots"], 2);
     assert_eq!(v["ran_seconds"], 2.0);
 
+    // The mandatory slave boots after the boot time (1 s): the network's
+    // boot failed (B); booted when it comes, it is not started: exit 1.
+    let (code, stdout, _) = run(&[
+        "net",
+        "boot",
+        "--simulate",
+        "--fault",
+        "left:late-boot=1500ms",
+        "--run",
+        "--duration",
+        "3s",
+        "tests/networks/boot/bus.yml",
+    ]);
+    assert_eq!(code, 1, "{stdout}");
+    assert!(
+        stdout.contains("left (node 2): booting again\n")
+            && stdout.ends_with(
+                "tests/networks/boot/bus.yml: the network did not boot: mandatory slaves not up: \
+                 left (node 2) booted\n"
+            ),
+        "{stdout}"
+    );
+
     // With --simulate --run needs a time; --duration needs --run.
     let bus = "tests/networks/boot/bus.yml";
     assert_eq!(run(&["net", "boot", "--simulate", "--run", bus]).0, 2);
