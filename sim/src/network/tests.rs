@@ -263,7 +263,7 @@ impl Service for Beacon {
     fn handle_timeout(&mut self, now: Instant) {
         if self.next <= now {
             self.due = true;
-            self.next = self.next + Duration::from_millis(7);
+            self.next += Duration::from_millis(7);
         }
     }
     fn poll_transmit(&mut self) -> Option<eds2rust_runtime::Frame> {
