@@ -249,3 +249,64 @@ fn faults_injected_while_running_happen_from_then_on() {
         .unwrap_err();
     assert!(error.to_string().contains("no node 9"), "{error}");
 }
+
+/// A service that sends a frame on 0x123 every 7 ms.
+#[derive(Debug, Default)]
+struct Beacon {
+    next: Instant,
+    due: bool,
+}
+
+impl Service for Beacon {
+    type Event = ();
+    fn handle_frame(&mut self, _: Instant, _: &eds2rust_runtime::Frame) {}
+    fn handle_timeout(&mut self, now: Instant) {
+        if self.next <= now {
+            self.due = true;
+            self.next += Duration::from_millis(7);
+        }
+    }
+    fn poll_transmit(&mut self) -> Option<eds2rust_runtime::Frame> {
+        std::mem::take(&mut self.due).then(|| eds2rust_runtime::Frame::standard(0x123, [0; 8], 0))
+    }
+    fn poll_event(&mut self) -> Option<()> {
+        None
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        Some(self.next)
+    }
+}
+
+#[test]
+fn an_inline_bus_on_a_manual_clock_keeps_both_sides_on_time() {
+    let time = ManualClock::new();
+    let beacon = Beacon {
+        next: Instant::from_millis(7),
+        due: false,
+    };
+    let bus = InlineBus::manual(beacon, time.clone()).with_trace();
+    let core = Master::new(node(1), Some(Duration::from_millis(20)));
+    let mut master = blocking::Master::with_clock(bus, core, time.clock());
+    master.start().unwrap();
+    master.run_for(Duration::from_millis(100)).unwrap();
+    let at = |id: u16| -> Vec<u64> {
+        master
+            .bus()
+            .trace()
+            .iter()
+            .filter(|(_, f)| f.standard_id() == Some(id))
+            .map(|(t, _)| t.as_micros())
+            .collect()
+    };
+    // The service's frames at its own times, exactly.
+    let beacons: Vec<u64> = (1..=14).map(|n| n * 7_000).collect();
+    assert_eq!(at(0x123), beacons);
+    // The master's heartbeats within one step of theirs (the one due at
+    // 100 ms is past the call's end).
+    let heartbeats = at(0x701);
+    assert_eq!(heartbeats.len(), 5, "{heartbeats:?}");
+    for (n, t) in heartbeats.iter().enumerate() {
+        let due = n as u64 * 20_000;
+        assert!(*t >= due && *t <= due + 1_000, "{heartbeats:?}");
+    }
+}
