@@ -9,8 +9,6 @@ use eds2rust_runtime::Instant;
 use eds2rust_runtime::boot::{BootStatus, Configuration, NetworkPlan, SlaveState, SlaveStatus};
 use serde_json::{Value, json};
 
-use super::run::Happening;
-
 /// The column titles.
 pub const HEADER: [&str; 8] = [
     "node",
@@ -22,6 +20,32 @@ pub const HEADER: [&str; 8] = [
     "time",
     "boot error",
 ];
+
+/// One thing that happened while the network ran.
+#[derive(Debug, Clone)]
+pub(crate) struct Happening {
+    /// Seconds since the master started.
+    pub seconds: f64,
+    pub node: u8,
+    /// Its name in the bus file (empty for a node the network lacks).
+    pub name: String,
+    /// `lost`, `rebooting`, `booted`, `started`, `failed`, `emcy`.
+    pub kind: &'static str,
+    pub text: String,
+}
+
+impl Happening {
+    /// `  1.234 s  axis (node 40): lost: E: no heartbeat came from the node`
+    pub fn line(&self) -> String {
+        let who = if self.name.is_empty() {
+            format!("node {}", self.node)
+        } else {
+            format!("{} (node {})", self.name, self.node)
+        };
+        let text = format!("{:>9.3} s  {who}: {}", self.seconds, self.text);
+        eds2rust::text::terminal_line(&text).into_owned()
+    }
+}
 
 /// How a boot ended.
 #[derive(Debug, Clone)]

@@ -14,36 +14,10 @@ use eds2rust_runtime::master::MasterEvent;
 use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::transport::Bus;
 
-use super::Outcome;
+use super::report::{Happening, Outcome};
 
 /// How often the loop looks at Ctrl-C; the lines' times are this exact.
 const POLL: Duration = Duration::from_millis(10);
-
-/// One thing that happened while the network ran.
-#[derive(Debug, Clone)]
-pub(crate) struct Happening {
-    /// Seconds since the master started.
-    pub seconds: f64,
-    pub node: u8,
-    /// Its name in the bus file (empty for a node the network lacks).
-    pub name: String,
-    /// `lost`, `rebooting`, `booted`, `started`, `failed`, `emcy`.
-    pub kind: &'static str,
-    pub text: String,
-}
-
-impl Happening {
-    /// `  1.234 s  axis (node 40): lost: E: no heartbeat came from the node`
-    pub fn line(&self) -> String {
-        let who = if self.name.is_empty() {
-            format!("node {}", self.node)
-        } else {
-            format!("{} (node {})", self.name, self.node)
-        };
-        let text = format!("{:>9.3} s  {who}: {}", self.seconds, self.text);
-        eds2rust::text::terminal_line(&text).into_owned()
-    }
-}
 
 /// What `event` says about a slave, if it is worth a line.
 fn describe(event: &MasterEvent) -> Option<(NodeId, &'static str, String)> {
