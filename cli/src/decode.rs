@@ -20,7 +20,8 @@ pub enum OutFormat {
     Json,
 }
 
-/// The files of the nodes: `--node N=FILE`, `--overlay N=FILE`.
+/// The files of the nodes: `--node N=FILE`, `--overlay N=FILE`, or a bus
+/// file (`--bus FILE`).
 #[derive(Args, Clone)]
 pub struct NodeFiles {
     /// The object dictionary of node N (1 to 127): an EDS/DCF file or a YAML
@@ -31,6 +32,11 @@ pub struct NodeFiles {
     /// times, applied in order.
     #[arg(long = "overlay", value_name = "N=FILE", value_parser = node_file)]
     pub overlays: Vec<(u8, PathBuf)>,
+    /// A bus file (bus.yml) instead of --node: its slaves and their device
+    /// files, with the PDOs the network configures (COB-IDs, mappings),
+    /// not the device files' defaults.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["nodes", "overlays"])]
+    pub bus: Option<PathBuf>,
 }
 
 #[derive(Args)]
@@ -65,8 +71,20 @@ fn node_file(text: &str) -> Result<(u8, PathBuf), String> {
 
 impl NodeFiles {
     /// A decoder with every node's file read; the diagnostics of a file
-    /// with errors (printed to stderr) make it `Err`.
+    /// with errors (printed to stderr) make it `Err`. With a bus file, each
+    /// slave's device as the network configures it
+    /// (`eds2rust::network::configured::configured_device`, as the
+    /// generated network and `api` of a bus file have it).
     pub fn decoder(&self) -> Result<Decoder, ExitCode> {
+        self.decoder_named().map(|(decoder, _)| decoder)
+    }
+
+    /// [`NodeFiles::decoder`], with the names of the nodes a bus file
+    /// names (none with `--node`).
+    pub fn decoder_named(&self) -> Result<(Decoder, Vec<(u8, String)>), ExitCode> {
+        if let Some(path) = &self.bus {
+            return bus_decoder(path);
+        }
         let mut decoder = Decoder::new();
         let mut seen = std::collections::BTreeSet::new();
         let mut err = io::stderr().lock();
@@ -106,8 +124,27 @@ impl NodeFiles {
                 }
             }
         }
-        Ok(decoder)
+        Ok((decoder, Vec::new()))
     }
+}
+
+/// The decoder of a bus file's network (see [`NodeFiles::decoder`]) and
+/// its slaves' names.
+fn bus_decoder(path: &std::path::Path) -> Result<(Decoder, Vec<(u8, String)>), ExitCode> {
+    let network = crate::net::load::read_configured(path, &Options::default(), "used")
+        .ok_or(ExitCode::from(1))?;
+    let _ = write!(io::stderr().lock(), "{}", network.warnings.render());
+    let mut decoder = Decoder::new();
+    let mut names = Vec::new();
+    for node in &network.configured.nodes {
+        let Some(slave) = network.bus.slaves.get(node.slave) else {
+            continue;
+        };
+        let device = eds2rust::network::configured::configured_device(&slave.device, node);
+        decoder.add_node(node.node_id, Arc::new(device));
+        names.push((node.node_id, node.name.clone()));
+    }
+    Ok((decoder, names))
 }
 
 /// Writes one record in `format`. Text is one terminal-safe line: names

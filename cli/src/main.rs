@@ -140,11 +140,11 @@ enum Command {
     /// stream, or a table of the nodes (--table), and a chart of PDO fields
     /// (--plot), until --duration ends or Ctrl-C.
     Monitor(monitor::MonitorArgs),
-    /// Simulates the device of an EDS/DCF file or YAML table on a SocketCAN
-    /// interface (docs/sim-cli.md): boot-up, SDO server, NMT, heartbeat,
-    /// PDOs, and a CiA 402 drive when the file is one; one line per NMT
-    /// change, SDO write and drive state change, until --duration ends or
-    /// Ctrl-C.
+    /// Simulates the device of an EDS/DCF file or YAML table, or every slave
+    /// of a bus file (--network, with --fault), on a SocketCAN interface
+    /// (docs/sim-cli.md): boot-up, SDO server, NMT, heartbeat, PDOs, CiA 402
+    /// drives; one line per NMT change, SDO write and drive state change,
+    /// until --duration ends or Ctrl-C.
     Sim(sim::SimArgs),
     /// Reads and writes objects of a live node by SDO (docs/live-bus.md).
     #[command(subcommand)]

@@ -1,5 +1,7 @@
 //! `eds2rust monitor`: a live SocketCAN bus through the decoder of
-//! `eds2rust decode` (the `eds2rust-decode` library): the record stream as
+//! `eds2rust decode` (the `eds2rust-decode` library), the nodes' files
+//! given one by one (`--node N=FILE`) or by a bus file (`--bus bus.yml`:
+//! the PDOs as the network configures them): the record stream as
 //! `decode` prints it, or a per-node table redrawn in place (`--table`), and
 //! the values of chosen PDO fields charted as SVG on exit (`--plot`).
 //!
@@ -190,6 +192,14 @@ impl Monitor {
         self
     }
 
+    /// Names the table's nodes (a bus file's slaves).
+    pub fn with_names(mut self, names: Vec<(u8, String)>) -> Monitor {
+        if let Some(table) = &mut self.table {
+            table.names = names.into_iter().collect();
+        }
+        self
+    }
+
     /// Receives and decodes frames from `bus` until `duration` has passed
     /// (forever without one) or `stop` is set, writing to `out` the record
     /// stream or the table; the table once more at the end.
@@ -361,7 +371,7 @@ impl Monitor {
 /// the interface cannot be opened or failed, a file has errors, the chart
 /// failed or a field was never seen, 2 usage errors.
 pub fn run(args: MonitorArgs) -> ExitCode {
-    let decoder = match args.files.decoder() {
+    let (decoder, names) = match args.files.decoder_named() {
         Ok(d) => d,
         Err(code) => return code,
     };
@@ -378,9 +388,13 @@ pub fn run(args: MonitorArgs) -> ExitCode {
         true => View::Terminal,
         false => View::Plain,
     });
-    let nodes: Vec<u8> = args.files.nodes.iter().map(|(n, _)| *n).collect();
+    // The nodes with a file: of --node or of the bus file.
+    let nodes: Vec<u8> = (1..=127)
+        .filter(|&n| decoder.dictionary(n).is_some())
+        .collect();
     let mut monitor = Monitor::new(decoder, &nodes, view, args.plot.clone())
         .with_format(args.format, args.unix_time)
+        .with_names(names)
         .with_title(format!("eds2rust monitor {}", args.iface));
     let until = match args.duration {
         Some(d) => format!("for {:.1} s", d.as_secs_f64()),
@@ -415,5 +429,7 @@ pub fn run(args: MonitorArgs) -> ExitCode {
     code
 }
 
+#[cfg(test)]
+mod bus_tests;
 #[cfg(test)]
 mod tests;

@@ -258,3 +258,47 @@ fn usage_and_input_errors() {
     assert_eq!(code(&["decode", "--node", "5=no/such/file.eds"]), Some(1));
     assert_eq!(code(&["decode", "no/such/trace.log"]), Some(1));
 }
+
+/// `--bus`: the nodes and their files from a bus file, the PDOs as the
+/// network configures them: the Zimmer axis's TPDO2 (node 40, 0x2A8)
+/// carries velocity and torque in the seed machine, velocity only by its
+/// file's default.
+#[test]
+fn a_bus_file_decodes_the_pdos_the_network_configures() {
+    let trace = "(0.000000) can0 2A8#E8030000FBFF\n";
+    let fields = |args: &[&str]| -> Vec<String> {
+        let records = json_lines(&eds2rust(args, Some(trace)));
+        records[0]["fields"]
+            .as_array()
+            .expect("fields")
+            .iter()
+            .map(|f| f["name"].as_str().expect("a name").to_string())
+            .collect()
+    };
+    assert_eq!(
+        fields(&["decode", "--bus", "eds/machine/bus.yml", "--format", "json"]),
+        ["Velocity actual value", "Torque actual value"]
+    );
+    assert_eq!(
+        fields(&[
+            "decode",
+            "--node",
+            "40=eds/zimmer_acs.yaml",
+            "--format",
+            "json"
+        ]),
+        ["Velocity actual value"]
+    );
+    let code = |args: &[&str]| eds2rust(args, Some("")).status.code();
+    assert_eq!(
+        code(&[
+            "decode",
+            "--bus",
+            "eds/machine/bus.yml",
+            "--node",
+            "5=eds/x.yaml"
+        ]),
+        Some(2)
+    );
+    assert_eq!(code(&["decode", "--bus", "no/such/bus.yml"]), Some(1));
+}

@@ -57,7 +57,9 @@ fn help_lists_the_options() {
     let (code, out, _) = run(&["sim", "--help"]);
     assert_eq!(code, 0);
     for text in [
-        "Usage: eds2rust sim [OPTIONS] --iface <IFACE> <FILE>",
+        "Usage: eds2rust sim [OPTIONS] --iface <IFACE> [FILE]",
+        "--network <BUS>",
+        "--fault <NODE:KIND[=VALUE]>",
         "-i, --iface <IFACE>",
         "-n, --node <N>",
         "--duration <SECONDS>",

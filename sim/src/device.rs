@@ -8,6 +8,7 @@ mod service;
 use std::collections::VecDeque;
 use std::time::Duration;
 
+use eds2rust_runtime::guarding::GuardResponder;
 use eds2rust_runtime::heartbeat::{HeartbeatConsumer, HeartbeatProducer};
 use eds2rust_runtime::lss::{BitRate, BitTiming, Identity, LssSlave, LssSlaveEvent};
 use eds2rust_runtime::nmt::{NmtCommand, NmtState};
@@ -90,6 +91,8 @@ pub struct Device<B: Behaviour> {
     config: DeviceConfig,
     server: SdoServer<Dictionary<B>>,
     heartbeat: Option<HeartbeatProducer>,
+    /// Answers node guarding (CiA 301) once the node has an id.
+    guard: Option<GuardResponder>,
     consumer: HeartbeatConsumer,
     lss: Option<LssSlave>,
     /// The node id that survives a power cycle (LSS store).
@@ -130,6 +133,7 @@ impl<B: Behaviour> Device<B> {
             config,
             server: SdoServer::new(server_config(node), dictionary),
             heartbeat: None,
+            guard: None,
             consumer: HeartbeatConsumer::new(),
             lss,
             stored_node: node,
@@ -187,6 +191,13 @@ impl<B: Behaviour> Device<B> {
         r
     }
 
+    /// Saves what the table holds now, as a write of "save" to 0x1010
+    /// does: it survives resets and power cycles.
+    pub fn save(&mut self) {
+        let d = self.server.store_mut();
+        d.saved = Some(d.table.clone());
+    }
+
     /// Switches the device off and on again at `now`: values not saved
     /// (0x1010) return to their defaults, the LSS-stored node id is used.
     pub fn power_cycle(&mut self, now: Instant) {
@@ -215,10 +226,13 @@ impl<B: Behaviour> Device<B> {
         d.now = now;
         let Some(node) = d.node else {
             self.heartbeat = None;
+            self.guard = None;
             self.server.set_extra_channels(Vec::new());
             return;
         };
         let ms = d.table.get_uint(0x1017, 0).unwrap_or(0);
+        // A new responder: the toggle starts at 0 after a boot.
+        self.guard = Some(GuardResponder::new(node));
         let mut producer = HeartbeatProducer::new(node, producer_time(ms));
         producer.start(now);
         self.heartbeat = Some(producer);
@@ -275,6 +289,9 @@ impl<B: Behaviour> Device<B> {
         d.nmt = to;
         if let Some(hb) = self.heartbeat.as_mut() {
             hb.set_state(to);
+        }
+        if let Some(guard) = self.guard.as_mut() {
+            guard.set_state(to);
         }
         if to == NmtState::Operational {
             self.load_pdos();

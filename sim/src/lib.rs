@@ -4,7 +4,8 @@
 //! - [`Device`] is a generic CiA 301 device built from a generated
 //!   `od::OBJECTS` table: an SDO server over an [`ObjectTable`] that
 //!   enforces access rights, types and limits; NMT slave with boot-up and
-//!   heartbeat (0x1017), heartbeat consumer (0x1016); TPDOs and RPDOs from
+//!   heartbeat (0x1017), heartbeat consumer (0x1016), node guarding
+//!   replies; TPDOs and RPDOs from
 //!   the communication and mapping parameters in the table (reconfigurable
 //!   over SDO with the CiA 301 rules); EMCY; SYNC; and, when configured,
 //!   an LSS slave (CiA 305). It is a sans-IO [`Service`](eds2rust_runtime::Service)

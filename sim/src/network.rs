@@ -71,6 +71,9 @@ pub struct Network {
     pub plan: NetworkPlan,
     /// The readers' warnings, one line each (`file:line: warning: ...`).
     pub warnings: Vec<String>,
+    /// How much faster than real time the CiA 402 drives' mechanics move
+    /// (1.0 by default).
+    pub time_scale: f64,
 }
 
 /// A fault that does not fit the network.
@@ -160,6 +163,7 @@ impl Network {
             slaves,
             plan,
             warnings,
+            time_scale: 1.0,
         }
     }
 
@@ -178,13 +182,12 @@ impl Network {
         self.slaves.iter().find(|s| s.name == name).map(|s| s.node)
     }
 
-    /// The simulation of every slave, started at `now`, with `faults`
-    /// (several per node are applied together). A fault on a node the
-    /// network does not have, or a [`Fault::ConfigurationCurrent`] on a
-    /// node whose configuration carries no date and time, is an error.
-    pub fn simulation(&self, faults: &[NodeFault], now: Instant) -> Result<Simulation, FaultError> {
+    /// Whether `faults` fit the network: each names a slave of it, and a
+    /// [`Fault::ConfigurationCurrent`] a slave whose configuration carries
+    /// a date and time (0x1020). The error says what to do.
+    pub fn check(&self, faults: &[NodeFault]) -> Result<(), FaultError> {
         for fault in faults {
-            if self.slave(fault.node).is_none() {
+            let Some(slave) = self.slave(fault.node) else {
                 let known: Vec<String> = self
                     .slaves
                     .iter()
@@ -199,8 +202,31 @@ impl Network {
                         known.join(", ")
                     ),
                 });
+            };
+            let dated = self
+                .plan
+                .slave(fault.node)
+                .is_some_and(|s| s.plan.configuration_date_time.is_some());
+            if fault.fault == Fault::ConfigurationCurrent && !dated {
+                return Err(FaultError {
+                    fault: *fault,
+                    reason: format!(
+                        "the configuration of `{}` in {} carries no date and time; add \
+                         `sdo:` writes of 0x1020 sub 1 (date) and sub 2 (time) to its section",
+                        slave.name,
+                        self.file.display()
+                    ),
+                });
             }
         }
+        Ok(())
+    }
+
+    /// The simulation of every slave, started at `now`, with `faults`
+    /// (several per node are applied together); an error when they do not
+    /// fit the network ([`Network::check`]).
+    pub fn simulation(&self, faults: &[NodeFault], now: Instant) -> Result<Simulation, FaultError> {
+        self.check(faults)?;
         let mut nodes = Vec::new();
         for slave in &self.slaves {
             let mine: Vec<Fault> = faults
@@ -209,6 +235,7 @@ impl Network {
                 .map(|f| f.fault)
                 .collect();
             let mut values = Vec::new();
+            let mut stored = Vec::new();
             for fault in &mine {
                 match *fault {
                     Fault::Identity(field, value) => values.push((field.object(), value)),
@@ -217,35 +244,31 @@ impl Network {
                         values.push(((0x1020, 2), time));
                     }
                     Fault::ConfigurationCurrent => {
-                        let plan = self.plan.slave(slave.node).map(|s| &s.plan);
-                        let Some((date, time)) = plan.and_then(|p| p.configuration_date_time)
-                        else {
-                            return Err(FaultError {
-                                fault: NodeFault::new(slave.node, *fault),
-                                reason: format!(
-                                    "the configuration of `{}` in {} carries no date and time; \
-                                     add `sdo:` writes of 0x1020 sub 1 (date) and sub 2 (time) \
-                                     to its section",
-                                    slave.name,
-                                    self.file.display()
-                                ),
-                            });
-                        };
-                        values.push(((0x1020, 1), date));
-                        values.push(((0x1020, 2), time));
+                        // Checked: the configuration carries a date and time.
+                        if let Some(config) = self.plan.slave(slave.node) {
+                            stored = config
+                                .plan
+                                .configuration
+                                .iter()
+                                .map(|w| (w.index, w.sub_index, w.data.to_vec()))
+                                .collect();
+                        }
                     }
                     _ => {}
                 }
             }
             let objects = with_values(slave.table.objects, &values);
-            nodes.push(SimNode::new(
+            let mut node = SimNode::new(
                 slave.name.clone(),
                 slave.node,
                 objects,
                 slave.drive,
                 &mine,
                 now,
-            ));
+            );
+            node.set_stored(stored);
+            node.set_time_scale(self.time_scale);
+            nodes.push(node);
         }
         Ok(Simulation::new(nodes, now))
     }

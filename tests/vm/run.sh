@@ -219,6 +219,7 @@ build_tests() {
     # seed-device simulators and python-canopen.
     local clijson=$VM/cargo-cli.json
     static_build -p eds2rust-cli --bin eds2rust --test live_vcan --test monitor_vcan --test sim_vcan \
+        --test net_boot_vcan \
         --message-format=json-render-diagnostics >"$clijson" ||
         infra "cargo build of the static CLI and its live-bus tests failed"
     local cli

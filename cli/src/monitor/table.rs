@@ -151,6 +151,8 @@ impl NodeRow {
 #[derive(Debug, Clone, Default)]
 pub struct NodeTable {
     pub rows: BTreeMap<u8, NodeRow>,
+    /// The nodes' names (a bus file's slaves), shown after their ids.
+    pub names: BTreeMap<u8, String>,
 }
 
 impl NodeTable {
@@ -159,6 +161,7 @@ impl NodeTable {
     pub fn new(nodes: impl IntoIterator<Item = u8>) -> NodeTable {
         NodeTable {
             rows: nodes.into_iter().map(|n| (n, NodeRow::default())).collect(),
+            names: BTreeMap::new(),
         }
     }
 
@@ -230,7 +233,10 @@ impl NodeTable {
                 p.prune(t);
             }
             table.add_row([
-                node.to_string(),
+                match self.names.get(node) {
+                    Some(name) => format!("{node} {name}"),
+                    None => node.to_string(),
+                },
                 row.state_text(),
                 row.heartbeat_text(t),
                 row.emcy_text(t),

@@ -24,6 +24,7 @@ fn linak_decoder() -> Decoder {
     let files = NodeFiles {
         nodes: vec![(LINAK, file)],
         overlays: Vec::new(),
+        bus: None,
     };
     files
         .decoder()

@@ -22,32 +22,7 @@ fn usage(message: &str) -> ExitCode {
 /// Reads and configures one side; `None` (its diagnostics printed) when
 /// either has errors.
 fn side(path: &Path, options: &Options) -> Option<(Bus, Configured)> {
-    let loaded = eds2rust::network::read_file(path, options);
-    let mut diagnostics = loaded.diagnostics;
-    let configured = match &loaded.bus {
-        Some(bus) if !diagnostics.has_errors() => {
-            let (configured, more) = eds2rust::network::configure(bus);
-            diagnostics.extend(more);
-            diagnostics.apply_levels(&options.levels, options.strict);
-            Some(configured)
-        }
-        _ => None,
-    };
-    match (loaded.bus, configured) {
-        (Some(bus), Some(configured)) if !diagnostics.has_errors() => Some((bus, configured)),
-        _ => {
-            diagnostics.errors_first();
-            let mut err = std::io::stderr().lock();
-            let _ = write!(err, "{}", diagnostics.render());
-            let _ = writeln!(
-                err,
-                "{}: not compared: {} errors",
-                path.display(),
-                diagnostics.error_count().max(1)
-            );
-            None
-        }
-    }
+    super::load::read_configured(path, options, "compared").map(|n| (n.bus, n.configured))
 }
 
 fn network((bus, configured): &(Bus, Configured)) -> Network<'_> {

@@ -21,8 +21,10 @@ use crate::live::bus::{self, LiveBus};
 
 fn args(file: PathBuf, node: u8) -> SimArgs {
     SimArgs {
-        file,
+        file: Some(file),
         overlays: Vec::new(),
+        network: None,
+        faults: Vec::new(),
         iface: "virtual".into(),
         node: Some(node),
         duration: None,
@@ -40,8 +42,11 @@ struct Running {
 
 impl Running {
     fn start(args: SimArgs) -> Running {
-        let table = eds2rust_sim::file::load_with_overlays(&args.file, &args.overlays)
-            .expect("the file reads");
+        let table = eds2rust_sim::file::load_with_overlays(
+            args.file.as_ref().expect("a file"),
+            &args.overlays,
+        )
+        .expect("the file reads");
         let node = NodeId::new(args.node.unwrap()).unwrap();
         let bus = VirtualBus::new();
         let port = bus.attach();

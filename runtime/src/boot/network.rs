@@ -494,7 +494,13 @@ impl NetworkBoot {
                         self.actions
                             .push_back(Action::Supervise(node, slave.config.supervision));
                         slave.supervised = true;
-                        slave.wait_until = Some(now + time.max(self.plan.response_time));
+                        // As every wait of a first boot, it ends with the
+                        // boot time (docs/network.md); else it lasts the
+                        // consumer time or the response time.
+                        slave.wait_until = Some(match self.deadline {
+                            Some(deadline) if slave.first => deadline.max(now),
+                            _ => now + time.max(self.plan.response_time),
+                        });
                     }
                     Request::Read { index, sub_index } => {
                         slave.pending = Some(Pending::Read(index, sub_index));

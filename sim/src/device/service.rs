@@ -26,6 +26,9 @@ impl<B: Behaviour> Service for Device<B> {
             return;
         }
         self.consumer.handle_frame(now, frame);
+        if let Some(guard) = self.guard.as_mut() {
+            guard.handle_frame(now, frame);
+        }
         let nmt = self.nmt_state();
         if nmt != NmtState::Stopped {
             if parse_sync_on(self.sync_cob_id(), frame).is_some() {
@@ -70,6 +73,9 @@ impl<B: Behaviour> Service for Device<B> {
         if let Some(hb) = self.heartbeat.as_mut()
             && let Some(f) = hb.poll_transmit()
         {
+            return Some(f);
+        }
+        if let Some(f) = self.guard.as_mut().and_then(Service::poll_transmit) {
             return Some(f);
         }
         if let Some(f) = self.outbox.pop_front() {

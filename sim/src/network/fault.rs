@@ -85,19 +85,21 @@ pub enum Fault {
         /// The abort code of the refusal.
         code: AbortCode,
     },
-    /// The node's heartbeat stops at `at` (it runs on otherwise, its
-    /// boot-up message included); with `resume`, it comes back that long
-    /// after it stopped.
+    /// The node's error control stops at `at`: no heartbeat, no answer to
+    /// node guarding (it runs on otherwise, its boot-up message
+    /// included); with `resume`, it comes back that long after it stopped.
     HeartbeatStops {
         /// When it stops.
         at: Duration,
         /// How long it stays away (`None`: for good).
         resume: Option<Duration>,
     },
-    /// 0x1020 (configuration date and time) holds the date and time the
-    /// network's configuration carries: a master finds the configuration
-    /// current and downloads nothing. The network's plan gives the values
-    /// (an error when it has none for the node).
+    /// The node was configured with the network's configuration before
+    /// and saved it (0x1010): it holds every value the configuration
+    /// writes, 0x1020 (configuration date and time) included, from its
+    /// power-on; a master finds the configuration current and downloads
+    /// nothing. An error for a node whose configuration carries no date
+    /// and time.
     ConfigurationCurrent,
     /// 0x1020 sub 1 and 2 hold this date and time.
     ConfigurationDate {

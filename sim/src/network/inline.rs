@@ -194,7 +194,8 @@ impl<S: Service> Bus for InlineBus<S> {
             Time::Manual(time) => {
                 let mut to = now + self.step;
                 if let Some(at) = self.service.poll_timeout() {
-                    to = to.min(at.max(now));
+                    // Time moves on, even past a timer that does not.
+                    to = to.min(at.max(now + Duration::from_micros(1)));
                 }
                 time.advance_to(to);
                 self.catch_up(to);

@@ -140,6 +140,8 @@ pub(super) struct SimNode {
     drive: bool,
     time_scale: f64,
     refused: Vec<(u16, u8, AbortCode)>,
+    /// Values the device holds saved (0x1010) from its first power-on.
+    stored: Vec<(u16, u8, Vec<u8>)>,
     pub(super) model: Option<Model>,
     pub(super) powered: bool,
     pub(super) heartbeat_off: bool,
@@ -183,7 +185,8 @@ impl SimNode {
             }
         }
         if faults.contains(&Fault::Missing) {
-            schedule.retain(|(_, s)| !matches!(s, Step::PowerOn | Step::PowerOff));
+            // Never on the bus: nothing else happens to it.
+            schedule.clear();
         }
         if let Some(at) = power_on {
             schedule.push((at, Step::PowerOn));
@@ -197,11 +200,62 @@ impl SimNode {
             drive,
             time_scale: 1.0,
             refused,
+            stored: Vec::new(),
             model: None,
             powered: false,
             heartbeat_off: false,
             schedule,
         }
+    }
+
+    /// Applies `fault` from `now` on (times count from `now`): power loss,
+    /// error control stop, a refused write, a late power-on of a node not
+    /// yet powered, or `Missing` (off for good). The others change what
+    /// the device holds from power-on: an error.
+    pub(super) fn inject(&mut self, now: Instant, fault: Fault) -> Result<(), &'static str> {
+        match fault {
+            Fault::Missing => {
+                self.schedule.clear();
+                self.schedule.push((now, Step::PowerOff));
+            }
+            Fault::LateBoot(d) => {
+                if self.powered || self.model.is_some() {
+                    return Err("the node was powered on already");
+                }
+                self.schedule.retain(|(_, s)| *s != Step::PowerOn);
+                self.schedule.push((now + d, Step::PowerOn));
+            }
+            Fault::PowerLoss { at, off } => {
+                self.schedule.push((now + at, Step::PowerOff));
+                self.schedule.push((now + at + off, Step::PowerOn));
+            }
+            Fault::HeartbeatStops { at, resume } => {
+                self.schedule.push((now + at, Step::HeartbeatOff));
+                if let Some(r) = resume {
+                    self.schedule.push((now + at + r, Step::HeartbeatOn));
+                }
+            }
+            Fault::SdoAbort { index, sub, code } => {
+                self.refused.push((index, sub, code));
+                if let Some(model) = self.model.as_mut() {
+                    each!(model, d => d.with_model(now, |b, _| b.refused.push((index, sub, code))));
+                }
+            }
+            Fault::Identity(..) | Fault::ConfigurationCurrent | Fault::ConfigurationDate { .. } => {
+                return Err(
+                    "it changes what the device holds from its power-on: give it to \
+                            `Network::simulation`",
+                );
+            }
+        }
+        self.schedule.sort_by_key(|(at, _)| *at);
+        Ok(())
+    }
+
+    /// Has the device hold `values` saved (0x1010) from its first
+    /// power-on, as a device that was configured and stored before.
+    pub(super) fn set_stored(&mut self, values: Vec<(u16, u8, Vec<u8>)>) {
+        self.stored = values;
     }
 
     pub(super) fn set_time_scale(&mut self, factor: f64) {
@@ -240,7 +294,7 @@ impl SimNode {
     fn power_on(&self, now: Instant) -> Model {
         let config = DeviceConfig::node(self.node);
         let refused = self.refused.clone();
-        if self.drive {
+        let mut model = if self.drive {
             let inner = Cia402::new().with_time_scale(self.time_scale);
             let model = Refusing { inner, refused };
             let mut device = Device::new(self.objects, config, model, now);
@@ -255,7 +309,25 @@ impl SimNode {
                 Refusing { inner: (), refused },
                 now,
             )))
+        };
+        if !self.stored.is_empty() {
+            // Configured and saved before: the values go in and are saved,
+            // then the device is powered on with them (the first boot-up,
+            // from the defaults, is not on the bus).
+            each!(&mut model, d => {
+                d.with_model(now, |_, ctx| {
+                    for (index, sub, data) in &self.stored {
+                        // An entry the table refuses keeps its default.
+                        let _ = ctx.table_mut().set_raw(*index, *sub, data);
+                    }
+                });
+                d.save();
+                while d.poll_transmit().is_some() {}
+                while d.poll_event().is_some() {}
+            });
+            model.power_cycle(now);
         }
+        model
     }
 
     /// The powered device.
@@ -290,8 +362,9 @@ impl SimNode {
         }
     }
 
-    /// The next frame the node sends; heartbeats are dropped while its
-    /// heartbeat is stopped (the boot-up message still goes).
+    /// The next frame the node sends; heartbeats and guarding replies are
+    /// dropped while its error control is stopped (the boot-up message
+    /// still goes).
     pub(super) fn poll_transmit(&mut self) -> Option<Frame> {
         let heartbeat = CanId::Standard(0x700 + u16::from(self.node.get()));
         let off = self.heartbeat_off;

@@ -9,6 +9,7 @@ use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::{Frame, Instant, Service};
 
 use super::node::{SimNode, Step};
+use super::{FaultError, NodeFault};
 use crate::cia402::Cia402Event;
 use crate::{ObjectTable, SimEvent};
 
@@ -83,20 +84,44 @@ impl Simulation {
         self.table(node)?.get_uint(index, sub)
     }
 
-    /// Sets the time scale of the CiA 402 drives' mechanics (for drives
-    /// powered on from now on).
-    pub fn set_time_scale(&mut self, factor: f64) {
-        for node in &mut self.nodes {
-            node.set_time_scale(factor);
-        }
+    /// Makes `fault` happen from `now` on, while the simulation runs (its
+    /// times count from `now`): a power loss, an error control stop, a
+    /// refused write, a late power-on of a node not yet powered, or
+    /// `Missing` (off from now on, for good). Faults on what a device holds
+    /// from power-on (identity, configuration) are given to
+    /// [`super::Network::simulation`]; here they are an error.
+    pub fn inject(&mut self, fault: NodeFault, now: Instant) -> Result<(), FaultError> {
+        let node = self
+            .nodes
+            .iter_mut()
+            .find(|n| n.node == fault.node)
+            .ok_or_else(|| FaultError {
+                fault,
+                reason: format!("the simulation has no node {}", fault.node),
+            })?;
+        node.inject(now, fault.fault).map_err(|why| FaultError {
+            fault,
+            reason: why.to_string(),
+        })?;
+        // What is due now happens now.
+        self.run_steps(now);
+        Ok(())
     }
 
     fn find(&self, node: NodeId) -> Option<&SimNode> {
         self.nodes.iter().find(|n| n.node == node)
     }
 
-    /// Applies the scheduled changes due at `now`.
+    /// Applies the scheduled changes due at `now` (after the events so
+    /// far, so that they stay in order).
     fn run_steps(&mut self, now: Instant) {
+        if self
+            .nodes
+            .iter()
+            .any(|n| n.next_step().is_some_and(|at| at <= now))
+        {
+            self.collect_events();
+        }
         for node in &mut self.nodes {
             while let Some(step) = node.take_step(now) {
                 node.apply(now, step);

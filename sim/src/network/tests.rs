@@ -139,3 +139,174 @@ fn the_blocking_master_boots_the_machine_in_virtual_time() {
         Some(eds2rust_runtime::nmt::NmtState::Operational)
     );
 }
+
+#[test]
+fn the_seed_machine_boots_and_its_pdos_flow_both_ways() {
+    let network = machine();
+    let time = ManualClock::new();
+    let sim = network.simulation(&[], time.now()).unwrap();
+    let bus = InlineBus::manual(sim, time.clone()).with_trace();
+    let core = Master::for_network(network.plan()).unwrap();
+    let mut master = blocking::Master::with_clock(bus, core, time.clock());
+    master.start().unwrap();
+    let report = master
+        .boot_network(network.plan().clone(), Instant::from_millis(10_000))
+        .unwrap();
+    assert!(report.booted, "{report:#?}");
+    assert!(
+        report
+            .slaves
+            .iter()
+            .all(|s| s.state == SlaveState::Operational),
+        "{report:#?}"
+    );
+    let from = time.now();
+    // The process data the master sends to the axis: controlword 0x000F
+    // (enable operation), target 1000.
+    let now = master.now();
+    let axis_rpdo = eds2rust_runtime::CanId::Standard(0x228);
+    let tx = master
+        .core_mut()
+        .pdo_tx
+        .iter_mut()
+        .find(|tx| tx.can_id() == axis_rpdo)
+        .expect("the master sends the axis's RPDO 1");
+    tx.set_data(now, &[0x0F, 0x00, 0xE8, 0x03, 0x00, 0x00])
+        .unwrap();
+    master.run_for(Duration::from_millis(200)).unwrap();
+    let count = |id: u16| {
+        master
+            .bus()
+            .trace()
+            .iter()
+            .filter(|(t, f)| *t >= from && f.standard_id() == Some(id))
+            .count()
+    };
+    // The axis's TPDO 1 (statusword, position) and RPDO 1 (controlword,
+    // target, from the master) every 10 ms SYNC.
+    assert!(count(0x1A8) >= 19, "{}", count(0x1A8));
+    assert!(count(0x228) >= 19, "{}", count(0x228));
+    // The conveyor's TPDO 4 each SYNC.
+    assert!(count(0x485) >= 19, "{}", count(0x485));
+}
+
+#[test]
+fn an_inline_bus_on_the_real_clock_boots_the_machine_in_real_time() {
+    let network = machine();
+    let clock = eds2rust_runtime::transport::Clock::new();
+    let sim = network.simulation(&[], clock.now()).unwrap();
+    let bus = InlineBus::new(sim, clock.clone());
+    let core = Master::for_network(network.plan()).unwrap();
+    let mut master = blocking::Master::with_clock(bus, core, clock);
+    master.start().unwrap();
+    let real = std::time::Instant::now();
+    let report = master
+        .boot_network(
+            network.plan().clone(),
+            std::time::Instant::now() + Duration::from_secs(10),
+        )
+        .unwrap();
+    assert!(report.booted, "{report:#?}");
+    // Waits for the first heartbeats (100 ms) took real time, not more.
+    let took = real.elapsed();
+    assert!(took < Duration::from_secs(3), "{took:?}");
+}
+
+#[test]
+fn faults_injected_while_running_happen_from_then_on() {
+    let network = machine();
+    let mut sim = network.simulation(&[], Instant::ZERO).unwrap();
+    frames(&mut sim);
+    let now = Instant::from_millis(500);
+    let loss = Fault::PowerLoss {
+        at: Duration::ZERO,
+        off: Duration::from_millis(100),
+    };
+    sim.inject(NodeFault::new(node(40), loss), now).unwrap();
+    assert!(!sim.is_powered(node(40)));
+    assert_eq!(
+        sim.poll_timeout().map(|t| t <= Instant::from_millis(600)),
+        Some(true)
+    );
+    let back = Instant::from_millis(600);
+    while sim.poll_timeout().is_some_and(|t| t <= back) {
+        let t = sim.poll_timeout().unwrap();
+        sim.handle_timeout(t);
+        frames(&mut sim);
+    }
+    assert!(sim.is_powered(node(40)));
+    let events: Vec<Event> = std::iter::from_fn(|| sim.poll_event()).collect();
+    assert!(events.contains(&Event::PoweredOff(node(40))));
+    assert!(events.contains(&Event::PoweredOn(node(40))));
+    // What the device holds from power-on is no fault to inject.
+    let wrong = Fault::Identity(IdentityField::VendorId, 1);
+    let error = sim
+        .inject(NodeFault::new(node(40), wrong), back)
+        .unwrap_err();
+    assert!(error.to_string().contains("Network::simulation"), "{error}");
+    let error = sim
+        .inject(NodeFault::new(node(9), Fault::Missing), back)
+        .unwrap_err();
+    assert!(error.to_string().contains("no node 9"), "{error}");
+}
+
+/// A service that sends a frame on 0x123 every 7 ms.
+#[derive(Debug, Default)]
+struct Beacon {
+    next: Instant,
+    due: bool,
+}
+
+impl Service for Beacon {
+    type Event = ();
+    fn handle_frame(&mut self, _: Instant, _: &eds2rust_runtime::Frame) {}
+    fn handle_timeout(&mut self, now: Instant) {
+        if self.next <= now {
+            self.due = true;
+            self.next += Duration::from_millis(7);
+        }
+    }
+    fn poll_transmit(&mut self) -> Option<eds2rust_runtime::Frame> {
+        std::mem::take(&mut self.due).then(|| eds2rust_runtime::Frame::standard(0x123, [0; 8], 0))
+    }
+    fn poll_event(&mut self) -> Option<()> {
+        None
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        Some(self.next)
+    }
+}
+
+#[test]
+fn an_inline_bus_on_a_manual_clock_keeps_both_sides_on_time() {
+    let time = ManualClock::new();
+    let beacon = Beacon {
+        next: Instant::from_millis(7),
+        due: false,
+    };
+    let bus = InlineBus::manual(beacon, time.clone()).with_trace();
+    let core = Master::new(node(1), Some(Duration::from_millis(20)));
+    let mut master = blocking::Master::with_clock(bus, core, time.clock());
+    master.start().unwrap();
+    master.run_for(Duration::from_millis(100)).unwrap();
+    let at = |id: u16| -> Vec<u64> {
+        master
+            .bus()
+            .trace()
+            .iter()
+            .filter(|(_, f)| f.standard_id() == Some(id))
+            .map(|(t, _)| t.as_micros())
+            .collect()
+    };
+    // The service's frames at its own times, exactly.
+    let beacons: Vec<u64> = (1..=14).map(|n| n * 7_000).collect();
+    assert_eq!(at(0x123), beacons);
+    // The master's heartbeats within one step of theirs (the one due at
+    // 100 ms is past the call's end).
+    let heartbeats = at(0x701);
+    assert_eq!(heartbeats.len(), 5, "{heartbeats:?}");
+    for (n, t) in heartbeats.iter().enumerate() {
+        let due = n as u64 * 20_000;
+        assert!(*t >= due && *t <= due + 1_000, "{heartbeats:?}");
+    }
+}

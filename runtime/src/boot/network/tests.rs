@@ -1,6 +1,7 @@
 use alloc::borrow::Cow;
 use alloc::vec;
 use alloc::vec::Vec;
+use core::time::Duration;
 
 use super::*;
 use crate::boot::{MasterPlan, SlavePlan};
@@ -107,4 +108,75 @@ fn a_second_boot_up_during_the_device_type_read_keeps_the_read() {
         "{next:?}"
     );
     assert_eq!(boot.slave(id(5)).unwrap().boots, 1);
+}
+
+/// Slave 5 answers 0x1000 and takes its one configuration write at `at`.
+fn identify_and_configure(boot: &mut NetworkBoot, at: Instant) {
+    boot.handle_frame(at, &boot_up(5));
+    assert_eq!(actions(boot), [read(5, 0x1000, 0)]);
+    boot.sdo_event(at, id(5), &uploaded(0x1000, 0, 0x192));
+    actions(boot);
+    let done = ClientEvent::Downloaded {
+        index: 0x1017,
+        sub: 0,
+    };
+    assert!(boot.sdo_event(at, id(5), &done));
+}
+
+#[test]
+fn the_wait_for_the_first_heartbeat_ends_with_the_boot_time() {
+    let mut config = slave(5, true);
+    config.plan.heartbeat = true;
+    config.supervision = Supervision::Heartbeat(Duration::from_millis(150));
+    let mut p = plan(vec![config]);
+    p.boot_time = Some(Duration::from_millis(1000));
+    let mut boot = NetworkBoot::new(p);
+    boot.start(Instant::ZERO);
+    actions(&mut boot);
+    // The boot-up comes late, just within the boot time.
+    identify_and_configure(&mut boot, Instant::from_millis(990));
+    assert_eq!(
+        actions(&mut boot),
+        [Action::Supervise(
+            id(5),
+            Supervision::Heartbeat(Duration::from_millis(150))
+        )]
+    );
+    // Not 2 s (the response time) after it: at the boot time's end.
+    assert_eq!(boot.poll_timeout(), Some(Instant::from_millis(1000)));
+    boot.handle_timeout(Instant::from_millis(1000));
+    let events: Vec<NetworkEvent> = core::iter::from_fn(|| boot.poll_event()).collect();
+    let failed = events.iter().find_map(|e| match e {
+        NetworkEvent::Failed(error) => Some(error.status),
+        _ => None,
+    });
+    assert_eq!(failed, Some(BootStatus::HeartbeatNotStarted));
+    assert!(matches!(
+        events.last(),
+        Some(NetworkEvent::BootFailed { .. })
+    ));
+    assert_eq!(boot.outcome(), Some(false));
+}
+
+#[test]
+fn after_the_first_boot_the_heartbeat_wait_is_the_response_time() {
+    let mut config = slave(5, false);
+    config.plan.heartbeat = true;
+    config.supervision = Supervision::Heartbeat(Duration::from_millis(150));
+    let mut p = plan(vec![config]);
+    p.boot_time = Some(Duration::from_millis(1000));
+    let mut boot = NetworkBoot::new(p);
+    boot.start(Instant::ZERO);
+    actions(&mut boot);
+    // No boot-up within the boot time: the optional slave fails (B).
+    boot.handle_timeout(Instant::from_millis(1000));
+    assert_eq!(boot.outcome(), Some(true));
+    assert_eq!(actions(&mut boot), [Action::MasterOperational]);
+    // It comes later: booted again, with the response time to wait.
+    let later = Instant::from_millis(5000);
+    identify_and_configure(&mut boot, later);
+    assert_eq!(
+        boot.poll_timeout(),
+        Some(later + NetworkPlan::DEFAULT_RESPONSE_TIME)
+    );
 }
