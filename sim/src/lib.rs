@@ -17,6 +17,12 @@
 //! - `file` (feature `files`) reads the table of a device from an
 //!   EDS/DCF/YAML file at run time, for devices without generated code.
 //! - [`bench`](mod@bench) runs a master and a device in virtual time, for tests.
+//! - `boot_bench` (feature `files`) boots a generated network of many
+//!   simulated slaves on the [`timed_bus`] and measures the boot against
+//!   the least time its frames need on the wire.
+//! - [`timed_bus`] runs a master and many devices on one bus in virtual
+//!   time where every frame takes its bit time, one at a time (the boot
+//!   benchmark's bus).
 //! - [`harness`] runs a simulator and a master on the virtual bus (or, with
 //!   the feature `socketcan`, on a SocketCAN interface), with an optional
 //!   candump-style trace.
@@ -29,6 +35,8 @@
 
 pub mod behaviour;
 pub mod bench;
+#[cfg(feature = "files")]
+pub mod boot_bench;
 pub mod cia402;
 pub mod device;
 #[cfg(feature = "files")]
@@ -38,6 +46,7 @@ pub mod harness;
 pub mod models;
 pub mod program;
 pub mod store;
+pub mod timed_bus;
 
 pub use behaviour::{Behaviour, Context};
 pub use device::{Device, DeviceConfig, SimEvent};
