@@ -2,7 +2,7 @@
 //! kernel's SocketCAN stack, and the PDOs the network configures flow both
 //! ways.
 //!
-//! The network is `tests/networks/vm/bus.yml`: three devices of the EDS
+//! The network is `tests/networks/vm/python_slaves.yml`: three devices of the EDS
 //! corpus (../shared), each a python-canopen `LocalNode` built from its
 //! file by `tests/python/network_slaves.py` (boot-up, NMT, heartbeat, and
 //! PDOs as the master configures them). The master reads the bus file at
@@ -288,7 +288,7 @@ fn set_rpdo<B: eds2rust_runtime::transport::Bus>(master: &mut Master<B>, can_id:
 #[test]
 #[ignore = "needs SocketCAN and python-canopen in a VM: run by tests/vm/run.sh"]
 fn master_boots_python_slaves_and_pdos_flow() {
-    let bus_file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("networks/vm/bus.yml");
+    let bus_file = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("networks/vm/python_slaves.yml");
     let corpus = bus_file
         .parent()
         .expect("a folder")
