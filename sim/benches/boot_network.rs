@@ -4,11 +4,42 @@
 //! bus against the least time of the frames it needs, and the host time
 //! per node (see `eds2rust_sim::boot_bench`).
 //!
+//! The bus figures are deterministic; the host time is the least of
+//! [`RUNS`] runs (single thread, wall clock: other processes on the
+//! machine only make it longer).
+//!
 //! `cargo bench -p eds2rust-sim --bench boot_network [-- SLAVES]`
 
 use std::path::PathBuf;
 
-use eds2rust_sim::boot_bench::{Scenario, run};
+use eds2rust_sim::boot_bench::{Outcome, Scenario, run};
+
+/// Runs per scenario.
+const RUNS: usize = 5;
+
+/// The scenario run [`RUNS`] times: the outcome with the least host time.
+fn fastest(device: &std::path::Path, scenario: Scenario) -> Result<Outcome, String> {
+    let mut best: Option<Outcome> = None;
+    for _ in 0..RUNS {
+        let outcome = run(device, scenario)?;
+        let total = |o: &Outcome| o.host.master + o.host.devices;
+        if let Some(b) = &best {
+            assert_eq!(
+                (b.boot_time, b.needed_time, b.needed_frames),
+                (
+                    outcome.boot_time,
+                    outcome.needed_time,
+                    outcome.needed_frames
+                ),
+                "the bus figures differ between runs"
+            );
+        }
+        if best.as_ref().is_none_or(|b| total(&outcome) < total(b)) {
+            best = Some(outcome);
+        }
+    }
+    best.ok_or_else(|| "no run".to_string())
+}
 
 fn main() {
     let slaves = std::env::args()
@@ -18,12 +49,8 @@ fn main() {
     let device = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../eds/example.eds");
     let mut failed = false;
     for heartbeat_ms in [0, 100] {
-        let scenario = Scenario {
-            slaves,
-            bit_rate: 1_000_000,
-            heartbeat_ms,
-        };
-        match run(&device, scenario) {
+        let scenario = Scenario::new(slaves, heartbeat_ms);
+        match fastest(&device, scenario) {
             Ok(outcome) => {
                 print!("{}", outcome.summary());
                 failed |= !outcome.report.booted;

@@ -279,27 +279,50 @@ impl<M: Service> TimedBus<M> {
         self.host.devices += t.elapsed();
     }
 
+    /// Takes the master's frames and events. A core may act while handing
+    /// out its events (the composite master's network boot does: it takes
+    /// the end of its own SDO transfer, reports nothing, and has the
+    /// slave's next request ready), so frames are taken again after the
+    /// events until there are none.
     fn collect_master(&mut self) {
         let t = std::time::Instant::now();
-        while let Some(frame) = self.master.poll_transmit() {
-            if let Some(q) = self.queues.get_mut(0) {
-                q.push_back(frame);
+        loop {
+            while let Some(frame) = self.master.poll_transmit() {
+                if let Some(q) = self.queues.get_mut(0) {
+                    q.push_back(frame);
+                }
             }
-        }
-        while let Some(event) = self.master.poll_event() {
-            self.master_events.push_back(event);
+            while let Some(event) = self.master.poll_event() {
+                self.master_events.push_back(event);
+            }
+            match self.master.poll_transmit() {
+                Some(frame) => {
+                    if let Some(q) = self.queues.get_mut(0) {
+                        q.push_back(frame);
+                    }
+                }
+                None => break,
+            }
         }
         self.host.master += t.elapsed();
     }
 
+    /// Takes a device's frames and drops its events (as for the master,
+    /// until a round gives no frame).
     fn collect_device(&mut self, i: usize) {
         let (Some(d), Some(q)) = (self.devices.get_mut(i), self.queues.get_mut(i + 1)) else {
             return;
         };
-        while let Some(frame) = d.poll_transmit() {
-            q.push_back(frame);
+        loop {
+            while let Some(frame) = d.poll_transmit() {
+                q.push_back(frame);
+            }
+            d.drop_events();
+            match d.poll_transmit() {
+                Some(frame) => q.push_back(frame),
+                None => break,
+            }
         }
-        d.drop_events();
     }
 }
 

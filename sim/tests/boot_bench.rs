@@ -14,11 +14,7 @@ fn device() -> PathBuf {
 #[test]
 fn a_few_slaves_boot_on_the_timed_bus() {
     for heartbeat_ms in [0, 100] {
-        let scenario = Scenario {
-            slaves: 4,
-            bit_rate: 1_000_000,
-            heartbeat_ms,
-        };
+        let scenario = Scenario::new(4, heartbeat_ms);
         let outcome = run(&device(), scenario).unwrap_or_else(|e| panic!("{e}"));
         let summary = outcome.summary();
         assert!(outcome.report.booted, "{summary}\n{:#?}", outcome.report);
@@ -45,11 +41,7 @@ fn a_few_slaves_boot_on_the_timed_bus() {
 
 #[test]
 fn too_many_slaves_are_refused() {
-    let scenario = Scenario {
-        slaves: 127,
-        bit_rate: 1_000_000,
-        heartbeat_ms: 0,
-    };
+    let scenario = Scenario::new(127, 0);
     let e = run(&device(), scenario).expect_err("127 slaves do not fit");
     assert!(e.contains("1 to 126"), "{e}");
 }
