@@ -37,6 +37,7 @@ use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::pdo::PdoEvent;
 use eds2rust_runtime::transport::socketcan::SocketCanBus;
 use eds2rust_runtime::{CanId, Frame};
+use eds2rust_tests::vcan::{iface, python};
 use serde_json::{Value, json};
 
 /// The entry of `CAN_IFACES` this test uses (the VM's test binaries run
@@ -49,31 +50,6 @@ const REPLY: Duration = Duration::from_secs(20);
 /// How long it may take to start (python, canopen and three device files,
 /// read under an emulated CPU).
 const START: Duration = Duration::from_secs(90);
-
-fn iface() -> String {
-    let list = std::env::var("CAN_IFACES").unwrap_or_else(|_| {
-        panic!("CAN_IFACES is not set: it must list SocketCAN interfaces; tests/vm/run.sh does")
-    });
-    let names: Vec<&str> = list.split([' ', ',']).filter(|s| !s.is_empty()).collect();
-    names.get(IFACE).map_or_else(
-        || panic!("CAN_IFACES={list:?} has no entry {IFACE}"),
-        |n| (*n).to_string(),
-    )
-}
-
-fn python() -> PathBuf {
-    let path = match std::env::var_os("VCAN_PYTHON") {
-        Some(p) => PathBuf::from(p),
-        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/pyoracle/bin/python3"),
-    };
-    assert!(
-        path.exists(),
-        "no python interpreter at {} (set VCAN_PYTHON, or create the venv with the python \
-         oracle tests; in the VM, tests/vm/run.sh shares it read-only)",
-        path.display()
-    );
-    path
-}
 
 /// The bus file and its network, read and configured as `net boot` does.
 struct Network {
@@ -302,7 +278,7 @@ fn master_boots_python_slaves_and_pdos_flow() {
     }
     let network = read_network(&bus_file);
     let plan = boot_plan(&network.bus, &network.configured);
-    let name = iface();
+    let name = iface(IFACE);
     let nodes: Vec<Value> = network
         .configured
         .nodes
