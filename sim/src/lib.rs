@@ -21,6 +21,12 @@
 //!   with faults (missing, wrong identity, late boot, power loss, SDO
 //!   abort, heartbeat stop), as one service.
 //! - [`bench`](mod@bench) runs a master and a device in virtual time, for tests.
+//! - `boot_bench` (feature `files`) boots a generated network of many
+//!   simulated slaves on the [`timed_bus`] and measures the boot against
+//!   the least time its frames need on the wire.
+//! - [`timed_bus`] runs a master and many devices on one bus in virtual
+//!   time where every frame takes its bit time, one at a time (the boot
+//!   benchmark's bus).
 //! - [`harness`] runs a simulator and a master on the virtual bus (or, with
 //!   the feature `socketcan`, on a SocketCAN interface), with an optional
 //!   candump-style trace.
@@ -33,6 +39,8 @@
 
 pub mod behaviour;
 pub mod bench;
+#[cfg(feature = "files")]
+pub mod boot_bench;
 pub mod cia402;
 pub mod device;
 #[cfg(feature = "files")]
@@ -44,6 +52,7 @@ pub mod models;
 pub mod network;
 pub mod program;
 pub mod store;
+pub mod timed_bus;
 
 pub use behaviour::{Behaviour, Context};
 pub use device::{Device, DeviceConfig, SimEvent};

@@ -28,6 +28,7 @@ use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
 use eds2rust_runtime::transport::socketcan::SocketCanBus;
 use eds2rust_runtime::transport::{Bus, Clock};
 use eds2rust_runtime::{CanId, Frame, Service};
+use eds2rust_tests::vcan::{iface, python};
 use serde_json::{Value, json};
 
 /// Interface indices in `CAN_IFACES`, one per test (after the four the
@@ -39,40 +40,6 @@ const PDO: usize = 7;
 
 /// Waits for frames that must arrive; generous for an emulated VM.
 const ARRIVAL: Duration = Duration::from_secs(2);
-
-/// The interface of test `index`: the `index`th entry of `CAN_IFACES`.
-fn iface(index: usize) -> String {
-    let Ok(list) = std::env::var("CAN_IFACES") else {
-        panic!(
-            "CAN_IFACES is not set: it must list SocketCAN interfaces (vcan0 ... vcan7), \
-             one per test; tests/vm/run.sh does"
-        );
-    };
-    let names: Vec<&str> = list.split([' ', ',']).filter(|s| !s.is_empty()).collect();
-    match names.get(index) {
-        Some(name) => (*name).to_string(),
-        None => panic!(
-            "CAN_IFACES={list:?} names {} interfaces; this test uses entry {index}",
-            names.len()
-        ),
-    }
-}
-
-/// The python interpreter with python-canopen: `VCAN_PYTHON`, or the venv
-/// the python oracle tests create.
-fn python() -> PathBuf {
-    let path = match std::env::var_os("VCAN_PYTHON") {
-        Some(p) => PathBuf::from(p),
-        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../target/pyoracle/bin/python3"),
-    };
-    assert!(
-        path.exists(),
-        "no python interpreter at {} (set VCAN_PYTHON, or create the venv with the python \
-         oracle tests; in the VM, tests/vm/run.sh shares it read-only)",
-        path.display()
-    );
-    path
-}
 
 fn open(name: &str) -> SocketCanBus {
     SocketCanBus::open(name).unwrap_or_else(|e| panic!("opening {name}: {e}"))

@@ -9,7 +9,7 @@
 # Exit status: 0 the tests passed, 1 a test failed inside the VM,
 #              2 infrastructure failure (apt, download, build, boot,
 #                timeout, missing result marker); reason on stderr.
-# Environment: VM_TIMEOUT (seconds, default 300), VM_VCAN_COUNT (vcan
+# Environment: VM_TIMEOUT (seconds, default 480), VM_VCAN_COUNT (vcan
 #              interfaces, default 10), VM_MEMORY (MiB, default 512).
 set -Eeuo pipefail
 
@@ -24,10 +24,11 @@ say() { echo "vm: [${SECONDS}s] $*" >&2; }
 
 ROOT=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
 VM=$ROOT/target/vm
-TIMEOUT=${VM_TIMEOUT:-300}
+TIMEOUT=${VM_TIMEOUT:-480}
 # CAN_IFACES in the VM (tests/vm/init.sh): vcan0..vcan<N-1>. Entries 0-4:
 # cli/tests/live_vcan.rs, 4-7: tests/tests/vcan_python.rs, 8:
-# cli/tests/monitor_vcan.rs, 9: cli/tests/sim_vcan.rs.
+# cli/tests/monitor_vcan.rs, 9: cli/tests/sim_vcan.rs, 3:
+# tests/tests/vcan_network.rs (the binaries run one after another).
 VCAN_COUNT=${VM_VCAN_COUNT:-10}
 MEMORY=${VM_MEMORY:-512}
 TRIPLE=x86_64-unknown-linux-gnu
@@ -210,7 +211,7 @@ build_tests() {
         infra "cargo build of the static test binaries failed"
     # python-canopen against our runtime over vcan (tests/tests/vcan_python.rs).
     local pyjson=$VM/cargo-python.json
-    static_build -p eds2rust-tests --test vcan_python \
+    static_build -p eds2rust-tests --test vcan_python --test vcan_network \
         --message-format=json-render-diagnostics >"$pyjson" ||
         infra "cargo build of the static python-canopen test binary failed"
     # The CLI's live-bus commands (cli/tests/live_vcan.rs), `eds2rust
@@ -275,7 +276,8 @@ shares() {
     fi
     libdir=$(dirname "$(readlink -f /lib64/ld-linux-x86-64.so.2)")
     local dir
-    for dir in "$ROOT/tests/python" "$ROOT/cli/tests/python" "$PYVENV" "$prefix" "$libdir"; do
+    for dir in "$ROOT/tests/python" "$ROOT/cli/tests/python" "$ROOT/tests/networks/vm" \
+        "$PYVENV" "$prefix" "$libdir"; do
         [[ -d $dir && $dir != *[[:space:]=,]* ]] || infra "cannot share $dir into the VM"
         SHARES+=("$dir")
     done

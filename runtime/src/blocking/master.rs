@@ -327,6 +327,10 @@ impl<B: Bus> Master<B> {
                     Err(event) => self.push(event),
                 }
             }
+            // The cores may act on their events as they hand them out (the
+            // network boot starts a slave's next SDO request there): send
+            // that before waiting for the bus.
+            self.send_ready().map_err(RunError::Io)?;
             let now = self.clock.now();
             if deadline.is_some_and(|deadline| now >= deadline) {
                 return Err(RunError::Deadline);
