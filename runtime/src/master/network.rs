@@ -8,7 +8,7 @@ use alloc::collections::VecDeque;
 use core::fmt;
 use core::time::Duration;
 
-use super::{Master, MasterEvent};
+use super::{Master, MasterEvent, PDO_RX_SLOTS};
 use crate::Instant;
 use crate::boot::{Action, BootStatus, NetworkBoot, NetworkPlan, Supervision};
 use crate::guarding::GuardEvent;
@@ -33,15 +33,20 @@ pub enum PlanError {
 impl fmt::Display for PlanError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            PlanError::Sync(e) => write!(f, "the network's SYNC producer: {e:?}"),
+            PlanError::Sync(e) => write!(f, "the network's SYNC producer: {e}"),
             PlanError::Receive(node, n, e) => {
-                write!(
-                    f,
-                    "node {node} TPDO {n}: the master cannot receive it: {e:?}"
-                )
+                write!(f, "node {node} TPDO {n}: the master cannot receive it: {e}")?;
+                if *e == WatchError::Full {
+                    write!(
+                        f,
+                        " (the master receives at most {PDO_RX_SLOTS} PDOs; disable \
+                         the TPDOs it does not need in the bus file)"
+                    )?;
+                }
+                Ok(())
             }
             PlanError::Transmit(node, n, e) => {
-                write!(f, "node {node} RPDO {n}: the master cannot send it: {e:?}")
+                write!(f, "node {node} RPDO {n}: the master cannot send it: {e}")
             }
         }
     }
