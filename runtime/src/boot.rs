@@ -97,7 +97,14 @@ impl fmt::Display for BootError {
             }
             match (self.found, self.abort) {
                 (Some(found), _) => write!(f, ", found 0x{found:08X}")?,
-                (None, Some(abort)) => write!(f, ", the read was aborted: {abort}")?,
+                (None, Some(abort)) => {
+                    // The configuration writes; every other step reads.
+                    let transfer = match self.status {
+                        BootStatus::ConfigurationFailed => "write",
+                        _ => "read",
+                    };
+                    write!(f, ", the {transfer} was aborted: {abort}")?
+                }
                 (None, None) => {}
             }
             write!(f, ")")?;

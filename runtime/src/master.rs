@@ -454,7 +454,10 @@ impl Service for Master {
         at = earliest(at, self.pdo_rx.poll_timeout());
         at = earliest(at, self.time_tx.as_ref().and_then(Service::poll_timeout));
         at = earliest(at, self.guard.poll_timeout());
-        at = earliest(at, self.network.as_ref().and_then(|r| r.boot.poll_timeout()));
+        at = earliest(
+            at,
+            self.network.as_ref().and_then(|r| r.boot.poll_timeout()),
+        );
         for tx in &self.pdo_tx {
             at = earliest(at, tx.poll_timeout());
         }

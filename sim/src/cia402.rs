@@ -50,7 +50,9 @@
 //! Every object but 0x6040/0x6041 is optional: it is read only when the
 //! table has it, and values the model publishes go only to the entries the
 //! table has. A mode whose objects are missing ([`mode_needs`]) is refused
-//! with abort 0x06090030 when 0x6060 is written.
+//! with abort 0x06090030 when 0x6060 is written; a mode the drive does not
+//! run is refused too, unless 0x6502 declares it ([`declares_mode`]: taken,
+//! shown in 0x6061, the axis holds its position).
 
 mod logic;
 mod monitor;
@@ -65,7 +67,7 @@ use eds2rust_runtime::od::ObjectInfo;
 use eds2rust_runtime::sdo::abort::AbortCode;
 
 use crate::{Behaviour, Context, Device, DeviceConfig};
-pub use objects::{mode_needs, supports_mode};
+pub use objects::{declares_mode, mode_needs, supports_mode};
 use profiler::Profiler;
 
 /// Profile velocity (position units/s) when 0x6081 is absent or 0.
@@ -274,7 +276,7 @@ impl Behaviour for Cia402 {
         match (index, sub, data) {
             (objects::MODES_OF_OPERATION, 0, [mode]) => {
                 let mode = ModeOfOperation::from_i8(*mode as i8);
-                if supports_mode(ctx.table(), mode) {
+                if supports_mode(ctx.table(), mode) || declares_mode(ctx.table(), mode) {
                     Ok(())
                 } else {
                     Err(AbortCode::InvalidValue)

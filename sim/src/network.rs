@@ -35,7 +35,7 @@ use eds2rust::input::Options;
 use eds2rust::network::config::Configured;
 use eds2rust::network::model::Bus;
 use eds2rust_runtime::Instant;
-use eds2rust_runtime::boot::NetworkPlan;
+use eds2rust_runtime::boot::{NetworkPlan, SlaveConfig};
 use eds2rust_runtime::od::NodeId;
 
 pub use fault::{DEFAULT_ABORT, Fault, IdentityField, NodeFault};
@@ -224,7 +224,10 @@ impl Network {
 
     /// The simulation of every slave, started at `now`, with `faults`
     /// (several per node are applied together); an error when they do not
-    /// fit the network ([`Network::check`]).
+    /// fit the network ([`Network::check`]). Each slave holds the identity
+    /// and software version the network checks (0x1000, 0x1018 sub 1–4,
+    /// 0x1F56 sub 1 where the plan expects a value), so that without faults
+    /// every check passes.
     pub fn simulation(&self, faults: &[NodeFault], now: Instant) -> Result<Simulation, FaultError> {
         self.check(faults)?;
         let mut nodes = Vec::new();
@@ -234,7 +237,11 @@ impl Network {
                 .filter(|f| f.node == slave.node)
                 .map(|f| f.fault)
                 .collect();
-            let mut values = Vec::new();
+            // The device the network expects: the identity and software
+            // version it checks (the device file's [DeviceInfo], the bus
+            // file's revision, serial number and software version),
+            // whatever the file's defaults say.
+            let mut values = expected_values(self.plan.slave(slave.node));
             let mut stored = Vec::new();
             for fault in &mine {
                 match *fault {
@@ -272,6 +279,27 @@ impl Network {
         }
         Ok(Simulation::new(nodes, now))
     }
+}
+
+/// The identity values and software version `slave`'s plan checks (the
+/// non-zero ones), as (object, value).
+fn expected_values(slave: Option<&SlaveConfig>) -> Vec<((u16, u8), u32)> {
+    let Some(plan) = slave.map(|s| &s.plan) else {
+        return Vec::new();
+    };
+    let expected = [
+        plan.device_type,
+        plan.vendor_id,
+        plan.product_code,
+        plan.revision_number,
+        plan.serial_number,
+    ];
+    let objects = IdentityField::ALL.iter().map(|field| field.object());
+    objects
+        .chain([(0x1F56, 1)])
+        .zip(expected.into_iter().chain([plan.software_version]))
+        .filter(|(_, value)| *value != 0)
+        .collect()
 }
 
 #[cfg(test)]

@@ -77,6 +77,19 @@ static MINIMAL: &[O] = &[
     O::new(0x6060, 0, "Modes of operation", Integer8, Rw, true),
 ];
 
+/// [`MINIMAL`] with a target position and 0x6502 declaring profile
+/// position, velocity and interpolated position (0x43).
+static DECLARES_IP: &[O] = &[
+    O::new(0x1000, 0, "Device type", Unsigned32, Ro, false).with_default(int(402)),
+    O::new(0x6040, 0, "Controlword", Unsigned16, Rww, true),
+    O::new(0x6041, 0, "Statusword", Unsigned16, Ro, true),
+    O::new(0x6060, 0, "Modes of operation", Integer8, Rw, true),
+    O::new(0x6061, 0, "Modes of operation display", Integer8, Ro, true),
+    O::new(0x6064, 0, "Position actual value", Integer32, Ro, true),
+    O::new(0x607A, 0, "Target position", Integer32, Rww, true),
+    O::new(0x6502, 0, "Supported drive modes", Unsigned32, Ro, false).with_default(int(0x43)),
+];
+
 fn node() -> NodeId {
     NodeId::new(7).expect("node id")
 }
@@ -496,5 +509,42 @@ fn a_minimal_table_enables_and_refuses_modes_it_cannot_run() {
     assert!(!cia402::supports_mode(
         rig.bench.device.table(),
         ModeOfOperation::ProfileVelocity
+    ));
+}
+
+#[test]
+fn a_mode_the_drive_declares_but_does_not_run_is_taken_and_holds() {
+    let mut rig = Rig::new(DECLARES_IP);
+    rig.enable();
+    // Interpolated position (7): declared by 0x6502 bit 6, not run.
+    rig.bench
+        .download(node(), 0x6060, 0, &[7])
+        .expect("ip mode");
+    rig.bench.run_for(Duration::from_millis(50));
+    assert_eq!(rig.upload_int(0x6061), 7, "mode display");
+    rig.bench
+        .download(node(), 0x607A, 0, &5000i32.to_le_bytes())
+        .expect("target");
+    rig.bench.run_for(Duration::from_millis(200));
+    assert_eq!(rig.upload_int(0x6064), 0, "the axis holds");
+    assert_eq!(rig.statusword().state(), Some(State::OperationEnabled));
+    // Cyclic synchronous velocity (9): not declared, refused.
+    assert_eq!(
+        rig.bench.download(node(), 0x6060, 0, &[9]),
+        Err(SdoError::RemoteAbort(AbortCode::InvalidValue))
+    );
+    let table = rig.bench.device.table();
+    assert!(cia402::declares_mode(
+        table,
+        ModeOfOperation::InterpolatedPosition
+    ));
+    // Profile position is run, not merely declared.
+    assert!(!cia402::declares_mode(
+        table,
+        ModeOfOperation::ProfilePosition
+    ));
+    assert!(cia402::supports_mode(
+        table,
+        ModeOfOperation::ProfilePosition
     ));
 }

@@ -132,10 +132,10 @@ fn an_abort_while_configuring_is_status_j_naming_the_entry() {
         .unwrap_err();
     assert_eq!(error.status, BootStatus::ConfigurationFailed);
     assert_eq!(error.object, Some((0x6060, 0)));
-    assert!(
-        error
-            .to_string()
-            .starts_with("node 5: boot error J: the configuration download failed (0x6060 sub 0")
+    assert_eq!(
+        error.to_string(),
+        "node 5: boot error J: the configuration download failed (0x6060 sub 0, the write \
+         was aborted: 0x06090030 (invalid value for parameter (download only)))"
     );
 }
 

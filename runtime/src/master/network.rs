@@ -8,7 +8,8 @@ use alloc::collections::VecDeque;
 use core::fmt;
 use core::time::Duration;
 
-use super::{Master, MasterEvent};
+use super::{Master, MasterEvent, PDO_RX_SLOTS};
+use crate::Instant;
 use crate::boot::{Action, BootStatus, NetworkBoot, NetworkPlan, Supervision};
 use crate::guarding::GuardEvent;
 use crate::heartbeat::HeartbeatEvent;
@@ -17,7 +18,6 @@ use crate::od::standard::{EventTimer, InhibitTime, PdoCobId, TransmissionType};
 use crate::pdo::{TransmitterConfig, TransmitterConfigError, WatchError};
 use crate::sdo::client::SdoClient;
 use crate::sync::{SyncConfigError, SyncProducer};
-use crate::Instant;
 
 /// Why a plan's master part could not be set up.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -33,12 +33,20 @@ pub enum PlanError {
 impl fmt::Display for PlanError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            PlanError::Sync(e) => write!(f, "the network's SYNC producer: {e:?}"),
+            PlanError::Sync(e) => write!(f, "the network's SYNC producer: {e}"),
             PlanError::Receive(node, n, e) => {
-                write!(f, "node {node} TPDO {n}: the master cannot receive it: {e:?}")
+                write!(f, "node {node} TPDO {n}: the master cannot receive it: {e}")?;
+                if *e == WatchError::Full {
+                    write!(
+                        f,
+                        " (the master receives at most {PDO_RX_SLOTS} PDOs; disable \
+                         the TPDOs it does not need in the bus file)"
+                    )?;
+                }
+                Ok(())
             }
             PlanError::Transmit(node, n, e) => {
-                write!(f, "node {node} RPDO {n}: the master cannot send it: {e:?}")
+                write!(f, "node {node} RPDO {n}: the master cannot send it: {e}")
             }
         }
     }
@@ -71,8 +79,8 @@ impl Master {
             if !cob_id.is_valid() {
                 continue;
             }
-            let timeout = (link.event_timer != 0)
-                .then(|| Duration::from_millis(u64::from(link.event_timer)));
+            let timeout =
+                (link.event_timer != 0).then(|| Duration::from_millis(u64::from(link.event_timer)));
             master
                 .pdo_rx
                 .watch(cob_id, usize::from(link.len), timeout)

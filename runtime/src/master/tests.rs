@@ -272,3 +272,45 @@ fn time_frames_become_events_and_the_master_can_produce_time() {
     // 45_297_789 ms = 0x02B3_307D.
     assert_eq!(drain_frames(&mut m), ["100#7D30B3023C3D"]);
 }
+
+#[test]
+fn a_plan_with_more_pdos_than_the_master_receives_says_so() {
+    use crate::boot::{MasterPlan, NetworkPlan, PdoLink};
+    use alloc::borrow::Cow;
+    let links: Vec<PdoLink> = (0..=PDO_RX_SLOTS as u16)
+        .map(|i| PdoLink {
+            node: node(2),
+            number: i + 1,
+            cob_id: 0x181 + u32::from(i),
+            transmission: 1,
+            len: 2,
+            event_timer: 0,
+            inhibit_time: 0,
+        })
+        .collect();
+    let plan = NetworkPlan {
+        master: MasterPlan {
+            node: node(1),
+            heartbeat: None,
+            sync_period: None,
+            sync_overflow: 0,
+        },
+        slaves: Cow::Borrowed(&[]),
+        boot_time: None,
+        response_time: NetworkPlan::DEFAULT_RESPONSE_TIME,
+        start_nodes: true,
+        start_all_nodes: false,
+        start_master: true,
+        reset_all_nodes: false,
+        stop_all_nodes: false,
+        receive: Cow::Owned(links),
+        transmit: Cow::Borrowed(&[]),
+    };
+    let error = Master::for_network(&plan).unwrap_err();
+    assert_eq!(
+        error.to_string(),
+        "node 2 TPDO 33: the master cannot receive it: every PDO receiver slot is taken \
+         (the master receives at most 32 PDOs; disable the TPDOs it does not need in the \
+         bus file)"
+    );
+}

@@ -54,6 +54,8 @@ pub(crate) const HOMING_SPEEDS: u16 = 0x6099;
 pub(crate) const HOMING_ACCELERATION: u16 = 0x609A;
 /// Positioning option code (UNSIGNED16).
 pub(crate) const POSITIONING_OPTION_CODE: u16 = 0x60F2;
+/// Supported drive modes (UNSIGNED32): bit n - 1 for mode n.
+pub(crate) const SUPPORTED_DRIVE_MODES: u16 = 0x6502;
 /// Following error actual value (INTEGER32).
 pub(crate) const FOLLOWING_ERROR_ACTUAL: u16 = 0x60F4;
 /// Position demand internal value (INTEGER32).
@@ -63,7 +65,8 @@ pub(crate) const POSITION_DEMAND_INTERNAL: u16 = 0x60FC;
 /// controlword and statusword: profile position and cyclic synchronous
 /// position need 0x607A Target position, profile velocity 0x60FF Target
 /// velocity; homing needs nothing. Modes the generic drive does not run
-/// need nothing here: [`supports_mode`] refuses them.
+/// need nothing here: [`supports_mode`] refuses them (unless 0x6502
+/// declares them: [`declares_mode`]).
 pub fn mode_needs(mode: ModeOfOperation) -> &'static [(u16, &'static str)] {
     match mode {
         ModeOfOperation::ProfilePosition | ModeOfOperation::CyclicSynchronousPosition => {
@@ -78,17 +81,39 @@ pub fn mode_needs(mode: ModeOfOperation) -> &'static [(u16, &'static str)] {
 /// position (1), profile velocity (3), homing (6) and cyclic synchronous
 /// position (8), each only when the table has what [`mode_needs`] lists.
 pub fn supports_mode(table: &ObjectTable, mode: ModeOfOperation) -> bool {
-    let runs = matches!(
+    runs(mode)
+        && mode_needs(mode)
+            .iter()
+            .all(|(index, _)| table.info(*index, 0).is_some())
+}
+
+/// Whether the drive takes `mode` without running it: a mode of CiA 402
+/// (1 to 10) the generic drive does not run (velocity, torque,
+/// interpolated position, cyclic synchronous velocity and torque) that
+/// the table's 0x6502 Supported drive modes declares. The drive shows it
+/// in 0x6061 and holds its position; a network that configures such a
+/// mode boots against the simulation as against the device.
+pub fn declares_mode(table: &ObjectTable, mode: ModeOfOperation) -> bool {
+    let bit = match mode.as_i8() {
+        m @ 1..=10 => m - 1,
+        _ => return false,
+    };
+    !runs(mode)
+        && table
+            .get_uint(SUPPORTED_DRIVE_MODES, 0)
+            .is_some_and(|modes| modes >> bit & 1 == 1)
+}
+
+/// The modes the generic drive moves in.
+fn runs(mode: ModeOfOperation) -> bool {
+    matches!(
         mode,
         ModeOfOperation::NoMode
             | ModeOfOperation::ProfilePosition
             | ModeOfOperation::ProfileVelocity
             | ModeOfOperation::Homing
             | ModeOfOperation::CyclicSynchronousPosition
-    );
-    runs && mode_needs(mode)
-        .iter()
-        .all(|(index, _)| table.info(*index, 0).is_some())
+    )
 }
 
 /// The value of (index, 0) when the table has it.
