@@ -69,8 +69,10 @@ use crate::time::earliest;
 use crate::time_stamp::{TimeConsumer, TimeEvent, TimeProducer};
 use crate::{Frame, Instant, Service};
 
-/// Number of TPDOs the master's [`PdoReceiver`] can watch.
-pub const PDO_RX_SLOTS: usize = 32;
+/// Number of TPDOs the master's [`PdoReceiver`] can watch: 512, as many
+/// RPDOs as a CiA 302 manager's object dictionary has room for
+/// (0x1400–0x15FF), so that every TPDO of a full network fits.
+pub const PDO_RX_SLOTS: usize = 512;
 
 /// Number of [`MasterEvent::Sync`] events kept (when enabled); when full the
 /// oldest is dropped.

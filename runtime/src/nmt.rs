@@ -379,7 +379,11 @@ impl Service for NmtMaster {
         // After its boot-up message a node is Pre-operational by itself
         // (CiA 301): that is the master's view of it from then on.
         let booted_up = to == NmtState::BootUp;
-        let to = if booted_up { NmtState::PreOperational } else { to };
+        let to = if booted_up {
+            NmtState::PreOperational
+        } else {
+            to
+        };
         let from = slot.replace(to);
         if booted_up {
             self.events.push(NmtEvent::BootUp(node));

@@ -240,11 +240,7 @@ pub fn run(device: &Path, scenario: Scenario) -> Result<Outcome, String> {
         return Err(diagnostics.render());
     }
     let plan = boot_plan(&bus, &configured);
-    // The master's PDO receiver has room for PDO_RX_SLOTS TPDOs: it
-    // watches none here (the boot does not need them).
-    let mut master_plan = plan.clone();
-    master_plan.receive = Vec::new().into();
-    let master = Master::for_network(&master_plan).map_err(|e| e.to_string())?;
+    let master = Master::for_network(&plan).map_err(|e| e.to_string())?;
     let table = file::load(device).map_err(|e| e.to_string())?;
     let t0 = Instant::ZERO;
     let mut bus = TimedBus::new(scenario.bit_rate, master, t0);

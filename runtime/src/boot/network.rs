@@ -287,7 +287,7 @@ impl NetworkBoot {
             && slave.boot.as_ref().is_some_and(SlaveBoot::awaits_boot_up);
         let awaiting_heartbeat =
             booting && slave.boot.as_ref().is_some_and(SlaveBoot::awaits_heartbeat);
-        let without_reset = slave.config.plan.reset.is_none() || self.plan.reset_all_nodes;
+        let without_reset = slave.config.plan.reset.is_none() && !self.plan.reset_all_nodes;
         let lost = slave.status.state == SlaveState::Lost;
         // A boot-up while the read of 0x1000 that follows a boot-up is in
         // flight: the boot it starts would send that read again (two

@@ -281,7 +281,7 @@ fn a_plan_with_more_pdos_than_the_master_receives_says_so() {
         .map(|i| PdoLink {
             node: node(2),
             number: i + 1,
-            cob_id: 0x181 + u32::from(i),
+            cob_id: 0x100 + u32::from(i),
             transmission: 1,
             len: 2,
             event_timer: 0,
@@ -309,8 +309,8 @@ fn a_plan_with_more_pdos_than_the_master_receives_says_so() {
     let error = Master::for_network(&plan).unwrap_err();
     assert_eq!(
         error.to_string(),
-        "node 2 TPDO 33: the master cannot receive it: every PDO receiver slot is taken \
-         (the master receives at most 32 PDOs; disable the TPDOs it does not need in the \
+        "node 2 TPDO 513: the master cannot receive it: every PDO receiver slot is taken \
+         (the master receives at most 512 PDOs; disable the TPDOs it does not need in the \
          bus file)"
     );
 }
