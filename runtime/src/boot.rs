@@ -20,18 +20,17 @@
 
 mod network;
 mod plan;
+mod report;
 mod status;
 
 use alloc::vec::Vec;
 use core::fmt;
 
-pub use network::{
-    Action, Configuration, NetworkBoot, NetworkEvent, NetworkReport, SlaveState, SlaveStatus,
-    ends_boot,
-};
+pub use network::{Action, NetworkBoot};
 pub use plan::{
     ConfigWrite, MasterPlan, NetworkPlan, PdoLink, SlaveConfig, SlavePlan, Supervision,
 };
+pub use report::{Configuration, NetworkEvent, NetworkReport, SlaveState, SlaveStatus, ends_boot};
 pub use status::BootStatus;
 
 use crate::nmt::{NmtCommand, NmtState};
