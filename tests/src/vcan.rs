@@ -3,6 +3,7 @@
 //! and the python interpreter with python-canopen.
 
 use std::path::PathBuf;
+use std::process::{Child, Command, Stdio};
 
 /// The interface of test `index`: the `index`th entry of `CAN_IFACES`
 /// (`tests/vm/run.sh` sets it; each test uses its own interface).
@@ -38,4 +39,22 @@ pub fn python() -> PathBuf {
         path.display()
     );
     path
+}
+
+/// Starts `tests/python/<script>` with python-canopen's interpreter and
+/// `argument` (a JSON command), its stdin and stdout piped, its stderr
+/// shown with the test's.
+pub fn spawn_script(script: &str, argument: &str) -> Child {
+    let path = crate::workspace_root().join("tests/python").join(script);
+    assert!(path.exists(), "missing {}", path.display());
+    let python = python();
+    Command::new(&python)
+        .arg(&path)
+        .arg(argument)
+        .env("PYTHONDONTWRITEBYTECODE", "1")
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .unwrap_or_else(|e| panic!("starting {} {}: {e}", python.display(), path.display()))
 }

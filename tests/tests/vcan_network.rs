@@ -21,7 +21,7 @@
 
 use std::io::{BufRead, BufReader, Write};
 use std::path::{Path, PathBuf};
-use std::process::{Child, ChildStdin, Command, Stdio};
+use std::process::{Child, ChildStdin};
 use std::sync::Arc;
 use std::sync::mpsc::{Receiver, RecvTimeoutError, channel};
 use std::time::{Duration, Instant};
@@ -37,7 +37,7 @@ use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::pdo::PdoEvent;
 use eds2rust_runtime::transport::socketcan::SocketCanBus;
 use eds2rust_runtime::{CanId, Frame};
-use eds2rust_tests::vcan::{iface, python};
+use eds2rust_tests::vcan::{iface, spawn_script};
 use serde_json::{Value, json};
 
 /// The entry of `CAN_IFACES` this test uses (the VM's test binaries run
@@ -81,18 +81,7 @@ struct Slaves {
 
 impl Slaves {
     fn spawn(command: &Value) -> Slaves {
-        let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("python/network_slaves.py");
-        assert!(script.exists(), "missing {}", script.display());
-        let python = python();
-        let mut child = Command::new(&python)
-            .arg(&script)
-            .arg(command.to_string())
-            .env("PYTHONDONTWRITEBYTECODE", "1")
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .unwrap_or_else(|e| panic!("starting {}: {e}", python.display()));
+        let mut child = spawn_script("network_slaves.py", &command.to_string());
         let stdin = child.stdin.take();
         let stdout = BufReader::new(child.stdout.take().expect("piped stdout"));
         let (tx, lines) = channel();

@@ -10,8 +10,7 @@
 #![cfg(target_os = "linux")]
 
 use std::io::{BufRead, BufReader, Write};
-use std::path::PathBuf;
-use std::process::{Child, ChildStdin, ChildStdout, Command, Stdio};
+use std::process::{Child, ChildStdin, ChildStdout, Command};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
@@ -28,7 +27,7 @@ use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
 use eds2rust_runtime::transport::socketcan::SocketCanBus;
 use eds2rust_runtime::transport::{Bus, Clock};
 use eds2rust_runtime::{CanId, Frame, Service};
-use eds2rust_tests::vcan::{iface, python};
+use eds2rust_tests::vcan::{iface, python, spawn_script};
 use serde_json::{Value, json};
 
 /// Interface indices in `CAN_IFACES`, one per test (after the four the
@@ -63,18 +62,7 @@ struct Peer {
 
 impl Peer {
     fn spawn(command: &Value) -> Peer {
-        let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("python/vcan_peer.py");
-        assert!(script.exists(), "missing {}", script.display());
-        let python = python();
-        let mut child = Command::new(&python)
-            .arg(&script)
-            .arg(command.to_string())
-            .env("PYTHONDONTWRITEBYTECODE", "1")
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::inherit())
-            .spawn()
-            .unwrap_or_else(|e| panic!("starting {}: {e}", python.display()));
+        let mut child = spawn_script("vcan_peer.py", &command.to_string());
         let stdin = child.stdin.take();
         let stdout = BufReader::new(child.stdout.take().unwrap());
         Peer {
