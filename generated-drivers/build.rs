@@ -13,12 +13,7 @@ const DEVICES: &[&str] = &[
 ];
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let mut builder = eds2rust::Builder::new();
-    // The seed machine: the three devices on one bus (feature `machine`).
-    if std::env::var_os("CARGO_FEATURE_MACHINE").is_some() {
-        builder.network("machine", "../eds/machine/bus.yml");
-    }
-    builder
+    eds2rust::Builder::new()
         .device("zimmer_acs", "../eds/zimmer_acs.yaml")
         .device("linak_techline", "../eds/linak_techline.yaml")
         .device("interroll_ec5000bi", "../eds/interroll_ec5000bi.yaml")

@@ -33,14 +33,4 @@ pub mod example {
     include!(concat!(env!("OUT_DIR"), "/example.rs"));
 }
 
-/// The seed machine, from `eds/machine/bus.yml` (feature `machine`): the
-/// Zimmer axis (node 40), the LINAK actuator (32) and the Interroll
-/// conveyor (5) on one bus, each node's module with the PDOs the network
-/// configures, and `network` with the process image and the boot plan
-/// `network::PLAN` (the master's types: the runtime's `alloc` feature).
-#[cfg(feature = "machine")]
-pub mod machine {
-    include!(concat!(env!("OUT_DIR"), "/machine.rs"));
-}
-
 pub use eds2rust_runtime as runtime;

@@ -2,7 +2,7 @@
 //! (node 40), the LINAK TECHLINE actuator (node 32) and the Interroll
 //! EC5000 BI conveyor (node 5), each simulated by its seed model on ONE
 //! virtual bus, booted by the master from the generated network's plan
-//! (`eds2rust_drivers::machine::network::PLAN`, CiA 302-2: reset, identity
+//! (`eds2rust_machine::network::PLAN`, CiA 302-2: reset, identity
 //! check, configuration download, heartbeats, start), then run together
 //! through the PDOs the bus file configures, one step per SYNC (10 ms):
 //!
@@ -31,8 +31,8 @@ use std::io::Write;
 use std::process::ExitCode;
 use std::time::Duration;
 
-use eds2rust_drivers::machine::network::{self, Inputs, Outputs, PLAN};
-use eds2rust_drivers::machine::{actuator, axis, conveyor};
+use eds2rust_machine::network::{self, Inputs, Outputs, PLAN};
+use eds2rust_machine::{actuator, axis, conveyor};
 use eds2rust_runtime::blocking;
 use eds2rust_runtime::boot::{Configuration, NetworkEvent, NetworkReport};
 use eds2rust_runtime::master::{self, MasterEvent};

@@ -7,8 +7,8 @@
 use std::io::Write;
 use std::time::Duration;
 
-use eds2rust_drivers::machine::network::{Inputs, Outputs};
-use eds2rust_drivers::machine::{actuator, axis, conveyor};
+use eds2rust_machine::network::{Inputs, Outputs};
+use eds2rust_machine::{actuator, axis, conveyor};
 use eds2rust_runtime::Instant;
 use eds2rust_runtime::cia402::{Drive, DriveConfig, Event, Statusword};
 use eds2rust_runtime::od::Scaled as _;
