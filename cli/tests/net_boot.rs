@@ -1,5 +1,5 @@
 //! `eds2rust net boot --simulate`: the seed machine (eds/machine/bus.yml)
-//! and the fault-matrix network (tests/networks/boot/bus.yml) booted
+//! and the fault-matrix network (tests/networks/boot/matrix.yml) booted
 //! against their own simulation, in virtual time: the table is the same on
 //! every run and locked by a snapshot; exit codes and usage errors.
 
@@ -36,7 +36,12 @@ fn the_seed_machine_boots_in_its_simulation() {
 
 #[test]
 fn every_slave_row_says_what_its_boot_did() {
-    let (code, stdout, stderr) = run(&["net", "boot", "--simulate", "tests/networks/boot/bus.yml"]);
+    let (code, stdout, stderr) = run(&[
+        "net",
+        "boot",
+        "--simulate",
+        "tests/networks/boot/matrix.yml",
+    ]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     let rows: Vec<Vec<&str>> = stdout
         .lines()
@@ -81,7 +86,7 @@ fn every_slave_row_says_what_its_boot_did() {
     );
     assert!(
         stdout.ends_with(
-            "tests/networks/boot/bus.yml: 2 of 2 slaves operational in 0.050 s (simulated time)\n"
+            "tests/networks/boot/matrix.yml: 2 of 2 slaves operational in 0.050 s (simulated time)\n"
         ),
         "{stdout}"
     );
@@ -98,7 +103,7 @@ fn a_missing_mandatory_slave_fails_the_boot_with_status_b() {
         "--simulate",
         "--fault",
         "left:missing",
-        "tests/networks/boot/bus.yml",
+        "tests/networks/boot/matrix.yml",
     ]);
     assert_eq!(code, 1, "{stdout}{stderr}");
     let row = |node: &str| -> Vec<String> {
@@ -131,7 +136,7 @@ fn a_missing_mandatory_slave_fails_the_boot_with_status_b() {
     let summary = stdout.lines().last().unwrap_or_default();
     assert_eq!(
         summary,
-        "tests/networks/boot/bus.yml: the network did not boot: left: node 2: boot error B: \
+        "tests/networks/boot/matrix.yml: the network did not boot: left: node 2: boot error B: \
          the node did not answer the read of its device type (0x1000) (0x1000 sub 0)"
     );
 
@@ -143,7 +148,7 @@ fn a_missing_mandatory_slave_fails_the_boot_with_status_b() {
         "--simulate",
         "--fault",
         "3:missing",
-        "tests/networks/boot/bus.yml",
+        "tests/networks/boot/matrix.yml",
     ]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     assert!(
@@ -158,7 +163,7 @@ fn a_missing_mandatory_slave_fails_the_boot_with_status_b() {
         "--simulate",
         "--fault",
         "left:serial=5",
-        "tests/networks/boot/bus.yml",
+        "tests/networks/boot/matrix.yml",
     ]);
     assert_eq!(code, 1, "{stdout}");
     assert!(
@@ -175,7 +180,7 @@ fn json_has_the_outcome_and_every_slave() {
         "--simulate",
         "--format",
         "json",
-        "tests/networks/boot/bus.yml",
+        "tests/networks/boot/matrix.yml",
     ]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     let v: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON object");
@@ -193,7 +198,7 @@ fn json_has_the_outcome_and_every_slave() {
 
 #[test]
 fn usage_and_input_errors() {
-    let bus = "tests/networks/boot/bus.yml";
+    let bus = "tests/networks/boot/matrix.yml";
     // Neither --iface nor --simulate, or both: usage errors.
     assert_eq!(run(&["net", "boot", bus]).0, 2);
     assert_eq!(
@@ -233,7 +238,7 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
         "--run",
         "--duration",
         "2s",
-        "tests/networks/boot/bus.yml",
+        "tests/networks/boot/matrix.yml",
     ]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     let after: Vec<&str> = stdout
@@ -252,7 +257,7 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
             "left (node 2): booting again",
             "left (node 2): booted",
             "left (node 2): started",
-            "tests/networks/boot/bus.yml: 2 of 2 slaves operational after 2.000 s of running (simulated time)",
+            "tests/networks/boot/matrix.yml: 2 of 2 slaves operational after 2.000 s of running (simulated time)",
         ],
         "{stdout}"
     );
@@ -269,7 +274,7 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
         "2s",
         "--format",
         "json",
-        "tests/networks/boot/bus.yml",
+        "tests/networks/boot/matrix.yml",
     ]);
     assert_eq!(code, 0, "{stdout}");
     let v: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON object");
@@ -294,20 +299,20 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
         "--run",
         "--duration",
         "3s",
-        "tests/networks/boot/bus.yml",
+        "tests/networks/boot/matrix.yml",
     ]);
     assert_eq!(code, 1, "{stdout}");
     assert!(
         stdout.contains("left (node 2): booting again\n")
             && stdout.ends_with(
-                "tests/networks/boot/bus.yml: the network did not boot: mandatory slaves not up: \
+                "tests/networks/boot/matrix.yml: the network did not boot: mandatory slaves not up: \
                  left (node 2) booted\n"
             ),
         "{stdout}"
     );
 
     // With --simulate --run needs a time; --duration needs --run.
-    let bus = "tests/networks/boot/bus.yml";
+    let bus = "tests/networks/boot/matrix.yml";
     assert_eq!(run(&["net", "boot", "--simulate", "--run", bus]).0, 2);
     assert_eq!(
         run(&["net", "boot", "--simulate", "--duration", "1s", bus]).0,

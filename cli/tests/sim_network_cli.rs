@@ -10,7 +10,7 @@ use common::{run, tempdir};
 
 fn bus() -> String {
     format!(
-        "{}/../tests/networks/boot/bus.yml",
+        "{}/../tests/networks/boot/matrix.yml",
         env!("CARGO_MANIFEST_DIR")
     )
 }

@@ -1,6 +1,6 @@
 //! The CiA 302-2 boot fault matrix on the virtual bus: the master
 //! (`blocking::Master::boot_network`) boots
-//! tests/networks/boot/bus.yml against the network's own simulation
+//! tests/networks/boot/matrix.yml against the network's own simulation
 //! (`eds2rust_sim::network`) with one fault at a time, in virtual time
 //! (a manual clock the simulation moves in 1 ms steps, so the whole
 //! matrix takes well under a second of CPU). Each case checks the boot

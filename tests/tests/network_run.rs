@@ -298,7 +298,7 @@ fn boots_as_its_files_say(path: &std::path::Path, booted: bool, failed: &[u8]) {
 fn every_network_of_the_repository_boots_against_its_own_simulation() {
     let root = eds2rust_tests::workspace_root();
     boots_as_its_files_say(&root.join("eds/machine/bus.yml"), true, &[]);
-    boots_as_its_files_say(&root.join("tests/networks/boot/bus.yml"), true, &[]);
+    boots_as_its_files_say(&root.join("tests/networks/boot/matrix.yml"), true, &[]);
     // ros2_canopen-style networks written for `net check` and `net dcf`:
     // some remap PDOs their device files make read-only.
     let networks = root.join("tests/networks");

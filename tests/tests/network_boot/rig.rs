@@ -1,5 +1,5 @@
 //! The rig of the network boot tests (network_boot.rs, network_run.rs):
-//! tests/networks/boot/bus.yml booted by the master against the network's
+//! tests/networks/boot/matrix.yml booted by the master against the network's
 //! own simulation in virtual time, with helpers to read the outcome.
 #![allow(dead_code, unused_imports)] // each test file uses part of it
 
@@ -25,7 +25,7 @@ pub fn id(n: u8) -> NodeId {
 }
 
 pub fn network() -> Network {
-    let path = eds2rust_tests::workspace_root().join("tests/networks/boot/bus.yml");
+    let path = eds2rust_tests::workspace_root().join("tests/networks/boot/matrix.yml");
     Network::load(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 

@@ -31,7 +31,7 @@ fn args(faults: &[&str]) -> SimArgs {
 }
 
 fn bus_file() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/networks/boot/bus.yml")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../tests/networks/boot/matrix.yml")
 }
 
 #[test]
