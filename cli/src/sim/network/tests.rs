@@ -78,7 +78,7 @@ fn a_master_boots_the_simulated_network_and_the_lines_name_the_nodes() {
     assert_eq!(code, "ExitCode(unix_exit_status(0))", "{err}");
     for line in [
         "sim: ",
-        "bus.yml: 2 slaves on virtual; until Ctrl-C",
+        "matrix.yml: 2 slaves on virtual; until Ctrl-C",
         "sim:   node 2 left: ",
         "drive.yaml (a CiA 402 drive); fault: refuses writes to 0x2000 sub 0",
         "sim:   node 3 right: ",
