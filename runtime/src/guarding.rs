@@ -11,8 +11,9 @@
 use core::num::NonZeroU8;
 use core::time::Duration;
 
+use crate::error_control::parse_error_control;
 use crate::frame::{CanId, cob};
-use crate::heartbeat::{next_period, parse_error_control};
+use crate::heartbeat::next_period;
 use crate::nmt::NmtState;
 use crate::od::NodeId;
 use crate::queue::Ring;

@@ -27,20 +27,7 @@ pub const fn boot_up_frame(node: NodeId) -> Frame {
     heartbeat_frame(node, NmtState::BootUp)
 }
 
-/// Decodes an error-control data frame (boot-up, heartbeat or node-guarding
-/// reply): COB-ID 0x701..=0x77F, not remote, exactly one data byte. Returns
-/// the node and the raw byte (toggle bit included).
-pub fn parse_error_control(frame: &Frame) -> Option<(NodeId, u8)> {
-    if frame.is_remote() {
-        return None;
-    }
-    let id = frame.standard_id()?;
-    let node = NodeId::new(u8::try_from(id.checked_sub(0x700)?).ok()?)?;
-    match *frame.data() {
-        [byte] => Some((node, byte)),
-        _ => None,
-    }
-}
+pub use crate::error_control::parse_error_control;
 
 /// Decodes a heartbeat or boot-up frame into the node and its state; `None`
 /// for other frames and for state bytes that are no CiA 301 state.

@@ -35,6 +35,7 @@ extern crate std;
 pub mod boot;
 pub mod cia402;
 pub mod emcy;
+mod error_control;
 pub mod frame;
 pub mod guarding;
 pub mod heartbeat;

@@ -7,8 +7,8 @@
 
 use core::fmt;
 
+use crate::error_control::parse_error_control;
 use crate::frame::cob;
-use crate::heartbeat::parse_error_control;
 use crate::od::NodeId;
 use crate::{Frame, Instant, Service};
 

@@ -1,7 +1,7 @@
 //! CiA 301 (CANopen application layer and communication profile): the
 //! communication objects every device may have, 0x1000–0x1FFF.
 
-use super::meaning::{StdBit, StdMeaning, StdValues, bit, field};
+use super::std_meaning::{StdBit, StdMeaning, StdValues, bit, field};
 use super::{NumberedRange, StdName, obj, sub};
 
 /// Objects with one fixed index, and their standard sub-entries.

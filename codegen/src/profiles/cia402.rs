@@ -1,7 +1,7 @@
 //! CiA 402 (drives and motion control, IEC 61800-7-201): the device profile
 //! objects 0x6000–0x6FFF of a drive.
 
-use super::meaning::{StdBit, StdMeaning, StdPattern, StdValues, bit, pattern};
+use super::std_meaning::{StdBit, StdMeaning, StdPattern, StdValues, bit, pattern};
 use super::{StdName, obj, sub};
 
 pub(super) const OBJECTS: &[StdName] = &[

@@ -20,8 +20,10 @@ mod cia401;
 mod cia402;
 mod cia406;
 mod meaning;
+mod std_meaning;
 
-pub(crate) use meaning::{RuntimeType, apply};
+pub(crate) use meaning::apply;
+pub(crate) use std_meaning::RuntimeType;
 
 /// One standard name: an object (`sub: None`) or one of its sub-entries.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -5,8 +5,9 @@ use std::collections::BTreeMap;
 
 use serde_saphyr::Spanned;
 
-use super::entry::{entry_reference, find_entry, literal};
-use super::schema::{ErrorTableDef, NetworkDef, VariantDef};
+use super::entry::literal;
+use super::item::{entry_reference, find_entry};
+use super::schema::{DeviceDef, ErrorTableDef, NetworkDef, VariantDef};
 use super::{At, Ctx};
 use crate::ir::{
     Device, EntryOverride, ErrorCode, ErrorTable, ErrorTableKind, Identity, Lss, Variant,
@@ -201,7 +202,7 @@ pub(super) fn variants(ctx: &mut Ctx, device: &mut Device, defs: &[Spanned<Varia
         }
         let mut identity = Identity::default();
         if let Some(dev) = &d.device {
-            super::lower::apply_identity(ctx, &mut identity, dev, false);
+            apply_identity(ctx, &mut identity, dev, false);
         }
         if let Some(id) = &d.node_id {
             check_node_id(ctx, id, &here, "node_id");
@@ -258,5 +259,44 @@ pub(super) fn variants(ctx: &mut Ctx, device: &mut Device, defs: &[Spanned<Varia
             overrides,
             origin: ctx.origin(At::of(def)),
         });
+    }
+}
+
+/// Writes the identity fields a [`DeviceDef`] gives into `identity`.
+/// `whole` also accepts `description` (a variant's goes elsewhere).
+pub(super) fn apply_identity(
+    ctx: &mut Ctx,
+    identity: &mut Identity,
+    def: &Spanned<DeviceDef>,
+    whole: bool,
+) {
+    let d = &def.value;
+    let text = |t: &Option<Spanned<String>>| t.as_ref().map(|t| t.value.clone());
+    if let Some(v) = text(&d.vendor_name) {
+        identity.vendor_name = Some(v);
+    }
+    if let Some(v) = &d.vendor_number {
+        identity.vendor_number = Some(v.value);
+    }
+    if let Some(v) = text(&d.product_name) {
+        identity.product_name = Some(v);
+    }
+    if let Some(v) = &d.product_number {
+        identity.product_number = Some(v.value);
+    }
+    if let Some(v) = &d.revision_number {
+        identity.revision_number = Some(v.value);
+    }
+    if let Some(v) = text(&d.order_code) {
+        identity.order_code = Some(v);
+    }
+    if !whole && let Some(description) = &d.description {
+        ctx.error(
+            "table::misplaced-key",
+            At::of(description),
+            "variant device",
+            "description",
+            "a variant's description is `description:` of the variant itself".into(),
+        );
     }
 }

@@ -10,9 +10,9 @@ use std::path::{Path, PathBuf};
 
 use serde_saphyr::Spanned;
 
-use super::schema::{DeviceDef, Table};
+use super::schema::Table;
 use super::{At, Base, Ctx};
-use crate::ir::{Device, Identity, ProfileChoice};
+use crate::ir::{Device, ProfileChoice};
 
 /// Lowers `table`; every file read on the way (a `base:` EDS) is appended
 /// to `files`.
@@ -63,7 +63,7 @@ pub(super) fn lower(ctx: &mut Ctx, table: &Table, base: Base, files: &mut Vec<Pa
         Default::default()
     };
     if let Some(def) = &table.device {
-        apply_identity(ctx, &mut device.identity, def, true);
+        super::extra::apply_identity(ctx, &mut device.identity, def, true);
         if let Some(description) = &def.value.description {
             device.file_info.description = Some(description.value.clone());
         }
@@ -258,43 +258,4 @@ fn whole_device_start(ctx: &mut Ctx, table: &Table) -> Device {
         );
     }
     device
-}
-
-/// Writes the identity fields a [`DeviceDef`] gives into `identity`.
-/// `whole` also accepts `description` (a variant's goes elsewhere).
-pub(super) fn apply_identity(
-    ctx: &mut Ctx,
-    identity: &mut Identity,
-    def: &Spanned<DeviceDef>,
-    whole: bool,
-) {
-    let d = &def.value;
-    let text = |t: &Option<Spanned<String>>| t.as_ref().map(|t| t.value.clone());
-    if let Some(v) = text(&d.vendor_name) {
-        identity.vendor_name = Some(v);
-    }
-    if let Some(v) = &d.vendor_number {
-        identity.vendor_number = Some(v.value);
-    }
-    if let Some(v) = text(&d.product_name) {
-        identity.product_name = Some(v);
-    }
-    if let Some(v) = &d.product_number {
-        identity.product_number = Some(v.value);
-    }
-    if let Some(v) = &d.revision_number {
-        identity.revision_number = Some(v.value);
-    }
-    if let Some(v) = text(&d.order_code) {
-        identity.order_code = Some(v);
-    }
-    if !whole && let Some(description) = &d.description {
-        ctx.error(
-            "table::misplaced-key",
-            At::of(description),
-            "variant device",
-            "description",
-            "a variant's description is `description:` of the variant itself".into(),
-        );
-    }
 }

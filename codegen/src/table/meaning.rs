@@ -6,7 +6,7 @@ use std::collections::BTreeMap;
 
 use serde_saphyr::Spanned;
 
-use super::entry::{
+use super::item::{
     SEMANTIC_KEYS, entry_reference, find_entry, integer, only_pin, pin_object, rust_name,
 };
 use super::schema::{BitDef, EntryDef, PatternDef, Text, ValuesDef};

@@ -8,6 +8,7 @@
 
 mod entry;
 mod extra;
+mod item;
 mod levels;
 mod lower;
 mod meaning;

@@ -388,7 +388,7 @@ fn map_item(
         (None, Some(index)) => {
             let index = index.value;
             let sub = m.sub.as_ref().map_or(0, |s| s.value);
-            let entry = super::entry::find_entry(ctx, device, index, sub, at)?;
+            let entry = super::item::find_entry(ctx, device, index, sub, at)?;
             let widths = pdo::mappable_bits(entry.data_type);
             let bits = match (&m.bits, widths) {
                 (Some(b), _) => b.value,

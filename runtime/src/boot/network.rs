@@ -19,7 +19,7 @@ use super::{BootError, BootEvent, BootStatus, ConfigWrite, NetworkPlan, Request,
 use super::{
     Configuration, NetworkEvent, NetworkReport, SlaveConfig, SlaveState, SlaveStatus, Supervision,
 };
-use crate::heartbeat::parse_error_control;
+use crate::error_control::parse_error_control;
 use crate::nmt::{NmtCommand, NmtState, NmtTarget};
 use crate::od::NodeId;
 use crate::sdo::client::ClientEvent;
