@@ -67,7 +67,7 @@ fn listing(device: &Device) -> String {
         errors: &error_plans,
         diags: &mut scratch,
     };
-    let infos = entries::emit(&mut cx, &mut |_| {});
+    let infos = super::od_module::emit(&mut cx, &mut |_| {});
     let pdos = pdo::plan(device, &infos, &mut scratch);
 
     let mut lines = Lines(Vec::new());

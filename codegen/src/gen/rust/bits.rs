@@ -8,7 +8,7 @@ use quote::{format_ident, quote};
 use super::docs::{self, Doc};
 use super::naming::{Case, NameId, Namespace};
 use super::prim::{self, Prim};
-use super::values::{Ctx, value_doc};
+use super::value_parts::{Ctx, value_doc};
 use crate::ir::{BitField, Entry};
 
 pub(crate) fn bit_struct(
@@ -151,7 +151,7 @@ fn struct_with(
     extra: TokenStream,
 ) -> TokenStream {
     let ty = raw.tokens();
-    let raw_methods = super::values::raw_methods(&ty);
+    let raw_methods = super::value_parts::raw_methods(&ty);
     let derives = super::derives::value(raw);
     quote! {
         #doc

@@ -4,8 +4,6 @@
 //! types in `od`; ARRAY and RECORD objects are modules in `od` holding one
 //! type per sub-entry. Value types are generated beside their entry.
 
-use std::collections::BTreeMap;
-
 use proc_macro2::{Ident, TokenStream};
 use quote::quote;
 
@@ -54,93 +52,7 @@ pub(crate) struct Ctx<'a> {
     pub(crate) diags: &'a mut Diagnostics,
 }
 
-/// The `od` module's items, and the info of every entry by (index, subindex).
-/// The items of the `od` module, given to `sink` one group of items per
-/// object as they are made (so that they are formatted and dropped one at a
-/// time: see `format.rs`), and what the PDOs need to know of each entry.
-pub(crate) fn emit(
-    cx: &mut Ctx,
-    sink: &mut dyn FnMut(TokenStream),
-) -> BTreeMap<(u16, u8), EntryInfo> {
-    let od = od_plan::plan(cx.device, cx.errors, cx.diags);
-    let mut infos = BTreeMap::new();
-    for root in &od.root {
-        let (object, e) = (root.object, &root.entry);
-        let ident = od.root_names.get(e.zst);
-        let path = vec![super::naming::ident("od")];
-        sink(entry_items(
-            cx,
-            object,
-            e.entry,
-            &ident,
-            &e.value,
-            &od.root_names,
-            &path,
-            &object.name,
-        ));
-        infos.insert(
-            (object.index, e.entry.subindex),
-            info(cx, &path, e, &od.root_names),
-        );
-    }
-    for m in &od.modules {
-        let (object, module) = (m.object, &m.module);
-        let path = vec![super::naming::ident("od"), module.clone()];
-        let mut inner = TokenStream::new();
-        for e in &m.entries {
-            if e.is_indexed() {
-                inner.extend(super::arrays::items(cx, object, e, &m.names, &path));
-                let info = info(cx, &path, e, &m.names);
-                for element in &e.elements {
-                    infos.insert((object.index, element.subindex), info.clone());
-                }
-                continue;
-            }
-            let ident = m.names.get(e.zst);
-            inner.extend(entry_items(
-                cx,
-                object,
-                e.entry,
-                &ident,
-                &e.value,
-                &m.names,
-                &path,
-                &e.entry.name,
-            ));
-            infos.insert(
-                (object.index, e.entry.subindex),
-                info(cx, &path, e, &m.names),
-            );
-        }
-        let mut doc = Doc::new();
-        doc.para(format!(
-            "**{}**: object 0x{:04X}, {} with {} entries.",
-            docs::text(&object.name),
-            object.index,
-            match object.kind {
-                ObjectKind::Array => "ARRAY",
-                _ => "RECORD",
-            },
-            object.entries.len()
-        ));
-        standard_para(cx, object, &mut doc);
-        doc.origin(&object.origin);
-        let doc = doc.tokens_with_alias(&object.name, &module.to_string());
-        let index = super::prim::hex(u128::from(object.index));
-        sink(quote! {
-            #doc
-            pub mod #module {
-                use super::rt;
-                #[doc = " The object's index."]
-                pub const INDEX: u16 = #index;
-                #inner
-            }
-        });
-    }
-    infos
-}
-
-fn info(cx: &Ctx, module: &[Ident], e: &od_plan::EntryPlan, names: &Names) -> EntryInfo {
+pub(crate) fn info(cx: &Ctx, module: &[Ident], e: &od_plan::EntryPlan, names: &Names) -> EntryInfo {
     let rust_name = e.fixed_name.then(|| names.text(e.zst).to_string());
     let (value, raw) = match &e.value {
         Plan::Prim(p) | Plan::Runtime { raw: p, .. } => (None, Some(*p)),
@@ -171,7 +83,7 @@ fn info(cx: &Ctx, module: &[Ident], e: &od_plan::EntryPlan, names: &Names) -> En
 }
 
 #[allow(clippy::too_many_arguments)]
-fn entry_items(
+pub(crate) fn entry_items(
     cx: &mut Ctx,
     object: &Object,
     entry: &Entry,

@@ -10,7 +10,7 @@ use quote::quote;
 use super::docs::{self, Doc};
 use super::naming::{Case, NameId, Namespace};
 use super::prim::Prim;
-use super::values::Ctx;
+use super::value_parts::Ctx;
 use crate::ir::ValueTable;
 
 struct Variant<'a> {
@@ -320,7 +320,7 @@ pub(crate) fn raw_newtype(
     let doc = doc.tokens();
     let kind_doc =
         format!(" The meaning of the raw value (every raw value has one, see [`{kind}`]).");
-    let raw_methods = super::values::raw_methods(&ty);
+    let raw_methods = super::value_parts::raw_methods(&ty);
     let derives = super::derives::value(raw);
     quote! {
         #doc

@@ -178,7 +178,7 @@ fn emit_table(
         Prim::U16 => 4,
         _ => 8,
     };
-    let raw_methods = super::values::raw_methods(&ty);
+    let raw_methods = super::value_parts::raw_methods(&ty);
     let meaning_derives = super::derives::attr(super::derives::MEANING, false);
     let value_derives = super::derives::value(plan.raw);
     quote! {

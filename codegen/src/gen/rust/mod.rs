@@ -30,10 +30,12 @@ pub(crate) mod naming;
 pub(crate) mod network;
 mod network_plan;
 mod objects;
+mod od_module;
 pub(crate) mod od_plan;
 pub(crate) mod pdo;
 mod prim;
 mod scaled;
+mod value_parts;
 mod values;
 
 pub use api::{ApiListing, api_listing};
@@ -194,7 +196,7 @@ fn generate_parts(
     // dropped: the tokens of a whole device take many times its text.
     let mut od_body = String::new();
     let mut format_error = None;
-    let infos = entries::emit(&mut cx, &mut |items| {
+    let infos = od_module::emit(&mut cx, &mut |items| {
         if format_error.is_none() {
             match format::in_module(items) {
                 Ok(text) => od_body.push_str(&text),

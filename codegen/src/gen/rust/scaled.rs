@@ -63,7 +63,7 @@ pub(crate) fn scaled(
         }
     }
     let derives = super::derives::value(raw);
-    let raw_methods = super::values::raw_methods(&ty);
+    let raw_methods = super::value_parts::raw_methods(&ty);
     quote! {
         #doc
         #derives

@@ -13,6 +13,8 @@ use quote::{format_ident, quote};
 use super::docs::{self, Doc};
 use super::naming::{NameId, Names, Namespace};
 use super::prim::{self, Prim};
+pub(crate) use super::value_parts::Ctx;
+use super::value_parts::value_doc;
 use crate::ir::{Entry, Semantics};
 
 /// The value type chosen for an entry, with its names requested.
@@ -197,12 +199,6 @@ pub(crate) fn runtime_plan(
     (raw.tokens().to_string() == ty.raw).then_some(Plan::Runtime { path: ty.path, raw })
 }
 
-/// Everything the value-type emitters need of their surroundings.
-pub(crate) struct Ctx<'a> {
-    pub(crate) rt: &'a TokenStream,
-    pub(crate) diags: &'a mut crate::diag::Diagnostics,
-}
-
 /// The items of an entry's value type (nothing for primitives, bytes and
 /// error enums, which live elsewhere).
 pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> TokenStream {
@@ -327,16 +323,6 @@ pub(crate) fn emit(cx: &mut Ctx, entry: &Entry, plan: &Plan, names: &Names) -> T
     }
 }
 
-pub(crate) fn value_doc(entry: &Entry, what: &str) -> Doc {
-    let mut doc = Doc::new();
-    doc.para(format!("{what} of **{}**.", docs::text(&entry.name)));
-    if let Some(description) = &entry.semantics.description {
-        doc.source_para(description);
-    }
-    doc.origin(&entry.origin);
-    doc
-}
-
 fn unit_doc(doc: &mut Doc, s: &Semantics) {
     let unit = s.unit.as_deref().map(docs::text).unwrap_or_default();
     let mut line = format!("Physical value = raw × {}", s.scale.unwrap_or(1.0));
@@ -349,22 +335,6 @@ fn unit_doc(doc: &mut Doc, s: &Semantics) {
     doc.para(format!(
         "{line} (`value()` and `from_value()` of the runtime's `od::Scaled`)."
     ));
-}
-
-/// `from_raw`/`to_raw` of a newtype over the raw value (`Self(pub raw)`).
-pub(crate) fn raw_methods(ty: &TokenStream) -> TokenStream {
-    quote! {
-        #[doc = " The value with this raw form."]
-        #[inline]
-        pub const fn from_raw(raw: #ty) -> Self {
-            Self(raw)
-        }
-        #[doc = " The raw form on the bus."]
-        #[inline]
-        pub const fn to_raw(self) -> #ty {
-            self.0
-        }
-    }
 }
 
 /// `impl Scalar` for a generated type with inherent `from_raw`/`to_raw`.
