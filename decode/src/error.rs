@@ -5,7 +5,7 @@ use core::fmt;
 use std::io;
 
 use eds2rust::ir::DataType;
-use eds2rust_runtime::transport::trace::TraceError;
+use eds2rust_runtime::trace::TraceError;
 
 use crate::decoded::{Decoded, hex_bytes};
 

@@ -30,7 +30,7 @@ pub use record::{FrameRecord, Kind, Protocol, Record, TransferRecord};
 
 use std::io::{self, BufRead};
 
-use eds2rust_runtime::transport::trace::{ErrorKind, Reader};
+use eds2rust_runtime::trace::{ErrorKind, Reader};
 
 /// What [`decode_trace`] read.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]

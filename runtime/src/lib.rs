@@ -1,23 +1,17 @@
 //! eds2rust-runtime: the thin CANopen runtime that generated drivers talk through.
 //!
-//! - [`od`]: the object-dictionary traits and types that generated code
-//!   implements (entries as zero-sized types with type-level access rights,
-//!   value conversion, PDO structs, node ids). Needs only `core`.
-//! - [`frame`], [`time`]: classic CAN frames, CANopen identifiers, and the
-//!   caller-supplied monotonic clock of the protocol cores ([`time`] is not
-//!   the TIME service; that is [`time_stamp`]).
-//! - Protocol cores, sans-IO (fed frames and the current time; they return
-//!   frames to send, events and their next deadline through [`Service`]):
-//!   [`sdo`] (client and server: expedited, segmented, block), [`nmt`]
-//!   (master and slave), [`heartbeat`] (producer and consumer), [`guarding`]
-//!   (node guarding, both sides), [`emcy`] (consumer, error tables), [`sync`]
-//!   (producer and consumer), [`time_stamp`] (the TIME service: producer,
-//!   consumer and the TIME_OF_DAY codec), [`pdo`] (RPDO transmitter, TPDO
-//!   receiver, mapping configuration over SDO), [`lss`] (CiA 305 master and
-//!   slave), [`cia402`] (drive helper and device state machine).
-//! - With `std`: [`transport`] (the virtual bus, candump logs, fault
-//!   injection, SocketCAN, `embedded-can`) and the drivers [`blocking`] and,
-//!   with `tokio`, `tokio`.
+//! The source tree shows the sans-IO design: protocol cores that never do I/O,
+//! drivers that run them over a bus and a clock, and the buses themselves.
+//! Every module keeps its short path (`eds2rust_runtime::heartbeat`, not
+//! `…::cores::heartbeat`); the folders are how the source is kept.
+//!
+//! | folder | modules | needs |
+//! |---|---|---|
+//! | `src/` (root) | [`od`] object-dictionary traits and types that generated code implements (entries as zero-sized types with type-level access rights, value conversion, PDO structs, node ids); [`frame`] classic CAN frames and CANopen identifiers; [`time`] the caller-supplied monotonic clock of the cores (not the TIME service, that is [`time_stamp`]) | `core` |
+//! | `src/cores/` | the protocol cores, fed frames and the current time, giving frames to send, events and their next deadline through [`Service`]: [`sdo`] (client and server: expedited, segmented, block), [`nmt`] (master and slave), [`heartbeat`] (producer and consumer), [`guarding`] (node guarding, both sides), [`emcy`] (consumer, error tables), [`sync`] (producer and consumer), [`time_stamp`] (the TIME service and the TIME_OF_DAY codec), [`pdo`] (RPDO transmitter, TPDO receiver, mapping configuration over SDO), [`lss`] (CiA 305 master and slave), [`cia402`] (drive helper and device state machine); with `alloc`, `master` (all of a master's cores behind one `Service`) and `boot` (the CiA 302-2 boot of a network) | `core` (`alloc` where named) |
+//! | `src/drivers/` | `blocking` and, with `tokio`, `tokio`: the cores run over a bus and a clock, one call per request | `std` |
+//! | `src/transport/` | `transport`: the [`Bus`](transport::Bus) traits, clocks, the virtual bus, fault injection, SocketCAN (`socketcan`) and `embedded-can` adapters | `std` |
+//! | `src/trace/` | `trace`: recorded trace files, the `candump` log and text forms and PEAK-System `.trc`, read and written (the decoder reads through it too) | `std` |
 //!
 //! Features: `std` (default) and `alloc` (SDO buffers); `tokio`,
 //! `socketcan` (Linux) and `embedded-can` for the transports.
@@ -31,32 +25,26 @@ extern crate alloc;
 #[cfg(all(feature = "std", not(test)))]
 extern crate std;
 
-#[cfg(feature = "alloc")]
-pub mod boot;
-pub mod cia402;
-pub mod emcy;
-mod error_control;
-pub mod frame;
-pub mod guarding;
-pub mod heartbeat;
-pub mod lss;
-#[cfg(feature = "alloc")]
-pub mod master;
-pub mod nmt;
-pub mod od;
-pub mod pdo;
-mod queue;
-pub mod sdo;
-pub mod sync;
-pub mod time;
-pub mod time_stamp;
-
+mod cores;
 #[cfg(feature = "std")]
-pub mod blocking;
-#[cfg(feature = "tokio")]
-pub mod tokio;
+mod drivers;
+pub mod frame;
+pub mod od;
+mod queue;
+pub mod time;
+#[cfg(feature = "std")]
+pub mod trace;
 #[cfg(feature = "std")]
 pub mod transport;
+
+use cores::error_control;
+#[cfg(feature = "alloc")]
+pub use cores::{boot, master};
+pub use cores::{cia402, emcy, guarding, heartbeat, lss, nmt, pdo, sdo, sync, time_stamp};
+#[cfg(feature = "std")]
+pub use drivers::blocking;
+#[cfg(feature = "tokio")]
+pub use drivers::tokio;
 
 /// `#[derive(Pdo)]`: a custom PDO mapping as a struct of mapped entries
 /// (docs/custom-pdos.md).

@@ -3,8 +3,8 @@
 
 use std::time::Duration;
 
+use eds2rust_runtime::trace::candump::{Format, LogLine, Reader, Writer};
 use eds2rust_runtime::transport::Bus;
-use eds2rust_runtime::transport::candump::{Format, LogLine, Reader, Writer};
 use eds2rust_runtime::transport::virtual_bus::VirtualBus;
 use eds2rust_runtime::{CanId, Frame};
 

@@ -19,8 +19,8 @@ use std::sync::{Arc, Condvar, Mutex, MutexGuard, OnceLock, mpsc};
 use std::thread;
 use std::time::{Duration, Instant};
 
+use eds2rust_runtime::trace::candump::parse_frame;
 use eds2rust_runtime::transport::Bus;
-use eds2rust_runtime::transport::candump::parse_frame;
 use eds2rust_runtime::{CanId, Frame};
 use serde_json::Value;
 

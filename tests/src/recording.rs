@@ -45,7 +45,7 @@ use std::time::{Duration, Instant as StdInstant};
 
 use eds2rust::eds::Options;
 use eds2rust::r#gen::eds::to_eds;
-use eds2rust_runtime::transport::candump::{Format, Writer};
+use eds2rust_runtime::trace::candump::{Format, Writer};
 use eds2rust_runtime::transport::{Bus, Clock};
 use eds2rust_runtime::{Frame, Instant, Service, blocking};
 use serde_json::{Value, json};

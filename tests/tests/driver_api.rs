@@ -16,7 +16,7 @@ const TYPES: [&str; 3] = ["Master", "SdoClient", "DriveHandle"];
 type Listing = BTreeMap<(String, String), Vec<String>>;
 
 fn runtime_src() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../runtime/src")
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../runtime/src/drivers")
 }
 
 /// `name.rs` and every `.rs` under `name/`, tests left out.

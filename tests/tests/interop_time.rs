@@ -12,7 +12,7 @@ use std::process::Command;
 
 use eds2rust_runtime::Service;
 use eds2rust_runtime::time_stamp::{TimeConsumer, TimeEvent, TimeOfDay, TimeProducer};
-use eds2rust_runtime::transport::candump::parse_frame;
+use eds2rust_runtime::trace::candump::parse_frame;
 use eds2rust_runtime::{Frame, Instant};
 use eds2rust_tests::python::python;
 

@@ -6,7 +6,7 @@
 use std::time::Duration;
 
 use eds2rust_runtime::Frame;
-use eds2rust_runtime::transport::candump::parse_line;
+use eds2rust_runtime::trace::candump::parse_line;
 use eds2rust_sim::models;
 use eds2rust_tests::recording::{self, Session};
 

@@ -6,7 +6,6 @@
 //!   (tests) to the [`crate::Instant`] of the protocol cores.
 //! - [`virtual_bus`]: an in-process CAN bus for simulators and tests, with an
 //!   optional bit-time model ([`wire`] counts the bits of a frame).
-//! - [`candump`]: reads and writes the log and text formats of `candump`.
 //! - [`fault`]: fault injection between a core and a bus.
 //! - `embedded` (feature `embedded-can`): adapters for `embedded-can` devices.
 //! - `socketcan` (feature `socketcan`, Linux): SocketCAN sockets.
@@ -16,15 +15,12 @@ use std::io;
 
 use crate::Frame;
 
-pub mod candump;
 pub mod clock;
 #[cfg(feature = "embedded-can")]
 pub mod embedded;
 pub mod fault;
 #[cfg(all(feature = "socketcan", target_os = "linux"))]
 pub mod socketcan;
-pub mod trace;
-pub mod trc;
 pub mod virtual_bus;
 pub mod wire;
 

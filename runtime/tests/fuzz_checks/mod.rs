@@ -16,7 +16,7 @@ use eds2rust_runtime::sdo::client::{ClientConfig, Method, SdoClient};
 use eds2rust_runtime::sdo::proto::{BlockSegment, Request, Response};
 use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
 use eds2rust_runtime::sync::{SyncConsumer, parse_sync};
-use eds2rust_runtime::transport::candump::{self, Format};
+use eds2rust_runtime::trace::candump::{self, Format};
 use eds2rust_runtime::{CanId, Frame, Instant, Service};
 
 /// Most frames a core may want to send in answer to one input: a whole

@@ -6,7 +6,7 @@
 //!   frames; event-driven with inhibit time and event timer).
 //! - [`PdoReceiver`]: a fixed number of PDOs the master listens to; it keeps
 //!   the last data of each, reports length errors and reception timeouts,
-//!   and decodes generated [`od::Pdo`] structs.
+//!   and decodes generated [`crate::od::Pdo`] structs.
 //! - [`PdoConfig`]: the SDO writes that configure a PDO's mapping and
 //!   communication parameters in the order CiA 301 prescribes, with the
 //!   read-backs that verify them, as a plan of [`Step`]s that a

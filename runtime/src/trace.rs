@@ -38,9 +38,11 @@ use std::io::{self, BufRead};
 use std::string::{String, ToString};
 use std::vec::Vec;
 
-use super::candump::{self, MAX_LINE_LEN};
-use super::trc;
 use crate::Frame;
+use candump::MAX_LINE_LEN;
+
+pub mod candump;
+pub mod trc;
 
 #[cfg(test)]
 mod tests;
