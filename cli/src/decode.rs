@@ -11,6 +11,8 @@ use clap::{Args, ValueEnum};
 use eds2rust::input::Options;
 use eds2rust_decode::{Decoder, Record, TraceDecodeError, render};
 
+use crate::refusal::device_or_refuse;
+
 /// Output forms.
 #[derive(Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum OutFormat {
@@ -108,20 +110,11 @@ impl NodeFiles {
                 .filter(|(n, _)| n == node)
                 .map(|(_, p)| p.clone())
                 .collect();
-            let loaded = eds2rust::build::load_device(path, &overlays, &Options::default());
-            let d = &loaded.diagnostics;
-            match loaded.device {
-                Some(device) if !d.has_errors() => decoder.add_node(*node, Arc::new(device)),
-                _ => {
-                    let _ = write!(err, "{}", d.render());
-                    let _ = writeln!(
-                        err,
-                        "{}: not used for node {node}: {} errors",
-                        path.display(),
-                        d.error_count().max(1)
-                    );
-                    return Err(ExitCode::from(1));
-                }
+            let what = format!("used for node {node}");
+            let options = Options::default();
+            match device_or_refuse(path, &overlays, &options, &what, &mut err) {
+                Some(device) => decoder.add_node(*node, Arc::new(device)),
+                None => return Err(ExitCode::from(1)),
             }
         }
         Ok((decoder, Vec::new()))

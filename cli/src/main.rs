@@ -14,6 +14,7 @@ mod decode;
 mod live;
 mod monitor;
 mod net;
+mod refusal;
 mod sim;
 
 use std::io::Write;
@@ -21,7 +22,7 @@ use std::path::PathBuf;
 use std::process::ExitCode;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use eds2rust::diag::{Diagnostics, Levels};
+use eds2rust::diag::Levels;
 use eds2rust::input::{Options, read_device};
 
 #[derive(Parser)]
@@ -368,22 +369,8 @@ fn diff_side(
     overlays: &[PathBuf],
     options: &Options,
 ) -> Option<eds2rust::ir::Device> {
-    let loaded = eds2rust::build::load_device(path, overlays, options);
-    let d = &loaded.diagnostics;
-    match loaded.device {
-        Some(device) if !d.has_errors() => Some(device),
-        _ => {
-            let mut err = std::io::stderr().lock();
-            let _ = write!(err, "{}", d.render());
-            let _ = writeln!(
-                err,
-                "{}: not compared: {} errors",
-                path.display(),
-                d.error_count().max(1)
-            );
-            None
-        }
-    }
+    let err = &mut std::io::stderr().lock();
+    refusal::device_or_refuse(path, overlays, options, "compared", err)
 }
 
 fn diff(
@@ -520,7 +507,7 @@ fn generate(
             let _ = write!(std::io::stderr().lock(), "{}", out.warnings.render());
             out.code
         }
-        Err(diagnostics) => return failed(path, diagnostics, "generated"),
+        Err(diagnostics) => return refusal::failed(path, diagnostics, "generated"),
     };
     write_output(output, &code)
 }
@@ -537,23 +524,8 @@ fn api(path: &std::path::Path, overlays: &[PathBuf], options: &Options) -> ExitC
                 Err(code) => code,
             }
         }
-        Err(diagnostics) => failed(path, diagnostics, "listed"),
+        Err(diagnostics) => refusal::failed(path, diagnostics, "listed"),
     }
-}
-
-/// Prints the diagnostics of a failed input, errors first, then
-/// `FILE: not <what>: N errors`; exit status 1.
-fn failed(path: &std::path::Path, mut diagnostics: Diagnostics, what: &str) -> ExitCode {
-    diagnostics.errors_first();
-    let mut err = std::io::stderr().lock();
-    let _ = write!(err, "{}", diagnostics.render());
-    let _ = writeln!(
-        err,
-        "{}: not {what}: {} errors",
-        path.display(),
-        diagnostics.error_count().max(1)
-    );
-    ExitCode::from(1)
 }
 
 /// Writes `text` to standard output and flushes it. A reader that left

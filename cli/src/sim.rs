@@ -170,18 +170,11 @@ pub fn run(args: SimArgs) -> ExitCode {
             return ExitCode::from(2);
         }
     };
-    let table = match file::load_with_overlays(file, &args.overlays) {
+    let loaded = file::load_with_overlays(file, &args.overlays);
+    let table = match read_input(file, loaded, |t| &t.warnings, args.quiet, &mut err) {
         Ok(table) => table,
-        Err(e) => {
-            not_simulated(file, &e, &mut err);
-            return ExitCode::from(1);
-        }
+        Err(code) => return code,
     };
-    if !args.quiet {
-        for line in &table.warnings {
-            let _ = writeln!(err, "{line}");
-        }
-    }
     let Some(node) = args.node.and_then(NodeId::new).or(table.node) else {
         let _ = writeln!(
             err,
@@ -215,6 +208,29 @@ fn open(
 
 /// A file that does not read: its errors (each naming file and line),
 /// then what became of it.
+/// What `sim` read from `file` (a device file or, with `--network`, a bus
+/// file): on errors their lines and `FILE: not simulated: N errors` with
+/// exit status 1; else the readers' warnings (unless `--quiet`) and the
+/// input.
+fn read_input<T>(
+    file: &std::path::Path,
+    loaded: Result<T, file::LoadError>,
+    warnings: impl Fn(&T) -> &[String],
+    quiet: bool,
+    err: &mut dyn Write,
+) -> Result<T, ExitCode> {
+    let input = loaded.map_err(|e| {
+        not_simulated(file, &e, err);
+        ExitCode::from(1)
+    })?;
+    if !quiet {
+        for line in warnings(&input) {
+            let _ = writeln!(err, "{line}");
+        }
+    }
+    Ok(input)
+}
+
 fn not_simulated(file: &std::path::Path, e: &file::LoadError, err: &mut dyn Write) {
     for line in &e.errors {
         let _ = writeln!(err, "{line}");

@@ -11,7 +11,7 @@ use eds2rust_runtime::blocking::{self, Master};
 use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::sdo::SdoError;
 
-use super::bus::{self, LiveBus};
+use super::bus::{self, LiveBus, Opener};
 use super::od::Od;
 use super::sdo::transfer_error;
 use super::values::{self, Decoded};
@@ -72,11 +72,7 @@ fn command_object(index: u16) -> Option<&'static str> {
     }
 }
 
-pub fn upload(
-    open: impl FnOnce() -> Result<LiveBus, LiveError>,
-    a: &UploadArgs,
-    out: &mut dyn Write,
-) -> Result<(), LiveError> {
+pub fn upload(open: impl Opener, a: &UploadArgs, out: &mut dyn Write) -> Result<(), LiveError> {
     let od = Od::load(&a.od)?;
     let node = bus::node_id(a.node)?;
     let mut device = od.device.clone();
@@ -98,8 +94,7 @@ pub fn upload(
             }
         }
     }
-    let mut m = bus::master(open()?);
-    bus::sdo_client(&mut m, node, a.bus.timeout);
+    let mut m = bus::sdo_master(open()?, node, a.bus.timeout);
     let bar = bus::bar(wanted.len() as u64, false);
     bar.set_message(format!("node {} upload", node.get()));
     let mut failed = Vec::new();
@@ -394,16 +389,11 @@ struct Tally {
     unchecked: usize,
 }
 
-pub fn download(
-    open: impl FnOnce() -> Result<LiveBus, LiveError>,
-    a: &DownloadArgs,
-    out: &mut dyn Write,
-) -> Result<(), LiveError> {
+pub fn download(open: impl Opener, a: &DownloadArgs, out: &mut dyn Write) -> Result<(), LiveError> {
     let od = Od::load(&a.dcf)?;
     let node = download_node(a, &od)?;
     let plan = plan(&od, node)?;
-    let mut m = bus::master(open()?);
-    bus::sdo_client(&mut m, node, a.bus.timeout);
+    let mut m = bus::sdo_master(open()?, node, a.bus.timeout);
     let bar = bus::bar(plan.steps.len() as u64, false);
     bar.set_message(format!("node {} download", node.get()));
     let mut tally = Tally::default();

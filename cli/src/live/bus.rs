@@ -119,6 +119,19 @@ pub fn master(bus: LiveBus) -> Master<LiveBus> {
     Master::new(bus, master::Master::new(MASTER_NODE, None))
 }
 
+/// What a command opens its bus with: called once, after the command line
+/// and the files have been checked.
+pub trait Opener: FnOnce() -> Result<LiveBus, LiveError> {}
+
+impl<F: FnOnce() -> Result<LiveBus, LiveError>> Opener for F {}
+
+/// A [`master`] on `bus` with an SDO client for `node` ([`sdo_client`]).
+pub fn sdo_master(bus: LiveBus, node: NodeId, timeout: Duration) -> Master<LiveBus> {
+    let mut m = master(bus);
+    sdo_client(&mut m, node, timeout);
+    m
+}
+
 /// Gives `node` an SDO client on its default channel with `timeout` per
 /// step.
 pub fn sdo_client(m: &mut Master<LiveBus>, node: NodeId, timeout: Duration) {

@@ -11,7 +11,7 @@ use eds2rust_runtime::master::MasterEvent;
 use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtTarget};
 use eds2rust_runtime::od::NodeId;
 
-use super::bus::{self, LiveBus};
+use super::bus::{self, LiveBus, Opener};
 use super::values::parse_int;
 use super::{BusArgs, LiveError, node_arg, parse_duration};
 
@@ -91,11 +91,7 @@ fn row(identity: &Identity) -> String {
     )
 }
 
-pub fn scan(
-    open: impl FnOnce() -> Result<LiveBus, LiveError>,
-    a: &ScanArgs,
-    out: &mut dyn Write,
-) -> Result<(), LiveError> {
+pub fn scan(open: impl Opener, a: &ScanArgs, out: &mut dyn Write) -> Result<(), LiveError> {
     let mut m = bus::master(open()?);
     m.core_mut().lss.set_timeout(a.lss_timeout);
     m.lss_switch_global(LssState::Waiting)
@@ -162,7 +158,7 @@ pub fn scan(
 }
 
 pub fn set_node_id(
-    open: impl FnOnce() -> Result<LiveBus, LiveError>,
+    open: impl Opener,
     a: &SetNodeIdArgs,
     out: &mut dyn Write,
 ) -> Result<(), LiveError> {

@@ -222,9 +222,9 @@ fn finish(result: Result<(), LiveError>) -> ExitCode {
 
 pub fn run_sdo(cmd: SdoCommand) -> ExitCode {
     match cmd {
-        SdoCommand::Read(a) => on_bus(&a.bus.clone(), |open, out| sdo::read(open, &a, out)),
-        SdoCommand::Write(a) => on_bus(&a.bus.clone(), |open, out| sdo::write(open, &a, out)),
-        SdoCommand::DownloadFile(a) => on_bus(&a.bus.clone(), |open, out| {
+        SdoCommand::Read(a) => on_bus(&a.to.bus.clone(), |open, out| sdo::read(open, &a, out)),
+        SdoCommand::Write(a) => on_bus(&a.to.bus.clone(), |open, out| sdo::write(open, &a, out)),
+        SdoCommand::DownloadFile(a) => on_bus(&a.to.bus.clone(), |open, out| {
             sdo::download_file(open, &a, out)
         }),
     }

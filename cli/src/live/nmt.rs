@@ -12,7 +12,7 @@ use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::sdo::SdoError;
 use eds2rust_runtime::sdo::client::ClientEvent;
 
-use super::bus::{self, LiveBus};
+use super::bus::{self, LiveBus, Opener};
 use super::{LiveError, NmtArgs, NmtVerb, ScanArgs};
 
 /// How long `--confirm` waits for the node.
@@ -38,11 +38,7 @@ fn io_failed(e: Error) -> LiveError {
     LiveError::Failed(e.to_string())
 }
 
-pub fn command(
-    open: impl FnOnce() -> Result<LiveBus, LiveError>,
-    a: &NmtArgs,
-    out: &mut dyn Write,
-) -> Result<(), LiveError> {
+pub fn command(open: impl Opener, a: &NmtArgs, out: &mut dyn Write) -> Result<(), LiveError> {
     let (cmd, name) = match a.verb {
         NmtVerb::Start => (NmtCommand::Start, "start"),
         NmtVerb::Stop => (NmtCommand::Stop, "stop"),
@@ -154,11 +150,7 @@ fn run(
     }
 }
 
-pub fn scan(
-    open: impl FnOnce() -> Result<LiveBus, LiveError>,
-    a: &ScanArgs,
-    out: &mut dyn Write,
-) -> Result<(), LiveError> {
+pub fn scan(open: impl Opener, a: &ScanArgs, out: &mut dyn Write) -> Result<(), LiveError> {
     let mut m = bus::master(open()?);
     let mut seen: BTreeMap<u8, Seen> = BTreeMap::new();
     let deadline = m.now() + a.listen;

@@ -11,22 +11,39 @@ use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::sdo::SdoError;
 use eds2rust_runtime::sdo::client::Method;
 
-use super::bus::{self, LiveBus};
+use super::bus::{self, Opener};
 use super::od::{self, Od};
 use super::values::{self, Decoded};
 use super::{BusArgs, LiveError, load_od, node_arg};
 
+/// The bus, the node and its object dictionary: what every `sdo` command
+/// starts from. Each command words the help of `--node` and `--od` its
+/// own way (`mut_arg`).
 #[derive(Args, Debug)]
-pub struct ReadArgs {
+pub struct NodeArgs {
     #[command(flatten)]
     pub bus: BusArgs,
-    /// The node to read from.
     #[arg(long, short = 'n', value_parser = node_arg)]
     pub node: u8,
-    /// The node's object dictionary (EDS, DCF or YAML table): objects by
-    /// name, values by type.
     #[arg(long, value_name = "FILE")]
     pub od: Option<PathBuf>,
+}
+
+impl NodeArgs {
+    /// The object dictionary of `--od` (if any) and the node id.
+    fn load(&self) -> Result<(Option<Od>, NodeId), LiveError> {
+        Ok((load_od(self.od.as_ref())?, bus::node_id(self.node)?))
+    }
+}
+
+#[derive(Args, Debug)]
+#[command(mut_arg("node", |a| a.help("The node to read from")))]
+#[command(mut_arg("od", |a| a.help(
+    "The node's object dictionary (EDS, DCF or YAML table): objects by name, values by type"
+)))]
+pub struct ReadArgs {
+    #[command(flatten)]
+    pub to: NodeArgs,
     /// Decode as this type (u8..u64, i8..i64, bool, f32, f64, str,
     /// unicode, bytes); wins over the type in --od.
     #[arg(long = "type", value_name = "TYPE", value_parser = values::parse_type)]
@@ -42,16 +59,13 @@ pub struct ReadArgs {
 }
 
 #[derive(Args, Debug)]
+#[command(mut_arg("node", |a| a.help("The node to write to")))]
+#[command(mut_arg("od", |a| a.help(
+    "The node's object dictionary: objects by name, values by type, unit and named values"
+)))]
 pub struct WriteArgs {
     #[command(flatten)]
-    pub bus: BusArgs,
-    /// The node to write to.
-    #[arg(long, short = 'n', value_parser = node_arg)]
-    pub node: u8,
-    /// The node's object dictionary: objects by name, values by type,
-    /// unit and named values.
-    #[arg(long, value_name = "FILE")]
-    pub od: Option<PathBuf>,
+    pub to: NodeArgs,
     /// The value's type (needed without --od; wins over its type).
     #[arg(long = "type", value_name = "TYPE", value_parser = values::parse_type)]
     pub ty: Option<DataType>,
@@ -68,15 +82,11 @@ pub struct WriteArgs {
 }
 
 #[derive(Args, Debug)]
+#[command(mut_arg("node", |a| a.help("The node to download to")))]
+#[command(mut_arg("od", |a| a.help("The node's object dictionary (for names)")))]
 pub struct DownloadFileArgs {
     #[command(flatten)]
-    pub bus: BusArgs,
-    /// The node to download to.
-    #[arg(long, short = 'n', value_parser = node_arg)]
-    pub node: u8,
-    /// The node's object dictionary (for names).
-    #[arg(long, value_name = "FILE")]
-    pub od: Option<PathBuf>,
+    pub to: NodeArgs,
     /// Use segmented instead of block transfer.
     #[arg(long)]
     pub segmented: bool,
@@ -153,19 +163,13 @@ fn label(od: Option<&Od>, index: u16, sub: u8) -> String {
     }
 }
 
-pub fn read(
-    open: impl FnOnce() -> Result<LiveBus, LiveError>,
-    a: &ReadArgs,
-    out: &mut dyn Write,
-) -> Result<(), LiveError> {
-    let od = load_od(a.od.as_ref())?;
-    let node = bus::node_id(a.node)?;
+pub fn read(open: impl Opener, a: &ReadArgs, out: &mut dyn Write) -> Result<(), LiveError> {
+    let (od, node) = a.to.load()?;
     let mut wanted = Vec::new();
     for text in &a.objects {
         wanted.extend(targets(od.as_ref(), text)?);
     }
-    let mut m = bus::master(open()?);
-    bus::sdo_client(&mut m, node, a.bus.timeout);
+    let mut m = bus::sdo_master(open()?, node, a.to.bus.timeout);
     let mut failed = Vec::new();
     for (index, sub) in wanted {
         let label = label(od.as_ref(), index, sub);
@@ -181,7 +185,7 @@ pub fn read(
                         ..
                     } | blocking::Error::Io(_)
                 );
-                failed.push(transfer_error(node, &label, "read", &e, a.bus.timeout));
+                failed.push(transfer_error(node, &label, "read", &e, a.to.bus.timeout));
                 if stop {
                     break;
                 }
@@ -238,13 +242,8 @@ pub fn report_failures(failed: Vec<LiveError>) -> Result<(), LiveError> {
     }
 }
 
-pub fn write(
-    open: impl FnOnce() -> Result<LiveBus, LiveError>,
-    a: &WriteArgs,
-    out: &mut dyn Write,
-) -> Result<(), LiveError> {
-    let od = load_od(a.od.as_ref())?;
-    let node = bus::node_id(a.node)?;
+pub fn write(open: impl Opener, a: &WriteArgs, out: &mut dyn Write) -> Result<(), LiveError> {
+    let (od, node) = a.to.load()?;
     let (index, sub) = match targets(od.as_ref(), &a.object)?.as_slice() {
         [one] => *one,
         many => {
@@ -280,15 +279,14 @@ pub fn write(
         .map_err(|why| LiveError::Usage(format!("{label}: {why}")))?;
     let data =
         values::encode(t, &value).map_err(|why| LiveError::Usage(format!("{label}: {why}")))?;
-    let mut m = bus::master(open()?);
-    bus::sdo_client(&mut m, node, a.bus.timeout);
+    let mut m = bus::sdo_master(open()?, node, a.to.bus.timeout);
     m.download(node, index, sub, &data)
-        .map_err(|e| transfer_error(node, &label, "write", &e, a.bus.timeout))?;
+        .map_err(|e| transfer_error(node, &label, "write", &e, a.to.bus.timeout))?;
     writeln!(out, "{label} := {}", values::describe(t, sem, &value))?;
     if a.verify {
         let back = m
             .upload(node, index, sub)
-            .map_err(|e| transfer_error(node, &label, "read-back", &e, a.bus.timeout))?;
+            .map_err(|e| transfer_error(node, &label, "read-back", &e, a.to.bus.timeout))?;
         let (read, _) = values::decode(t, &back).map_err(|why| {
             LiveError::Failed(format!("node {}, {label}: read-back: {why}", node.get()))
         })?;
@@ -312,12 +310,11 @@ pub fn write(
 }
 
 pub fn download_file(
-    open: impl FnOnce() -> Result<LiveBus, LiveError>,
+    open: impl Opener,
     a: &DownloadFileArgs,
     out: &mut dyn Write,
 ) -> Result<(), LiveError> {
-    let od = load_od(a.od.as_ref())?;
-    let node = bus::node_id(a.node)?;
+    let (od, node) = a.to.load()?;
     let (index, sub) = match targets(od.as_ref(), &a.object)?.as_slice() {
         [one] => *one,
         _ => {
@@ -346,8 +343,7 @@ pub fn download_file(
             a.file.display(),
         )));
     }
-    let mut m = bus::master(open()?);
-    bus::sdo_client(&mut m, node, a.bus.timeout);
+    let mut m = bus::sdo_master(open()?, node, a.to.bus.timeout);
     let bar = bus::bar(len, true);
     bar.set_message(format!("node {} {}", node.get(), od::key(index, sub)));
     let (method, how) = if a.segmented {
@@ -362,7 +358,7 @@ pub fn download_file(
     });
     bar.finish_and_clear();
     result.map_err(|e| {
-        let mut err = transfer_error(node, &label, "download", &e, a.bus.timeout);
+        let mut err = transfer_error(node, &label, "download", &e, a.to.bus.timeout);
         // What a server without block transfer answers a block initiate with.
         let no_block = matches!(
             &e,

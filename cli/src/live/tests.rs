@@ -89,11 +89,34 @@ fn zimmer() -> Sim {
     Sim::start(zimmer_acs::simulator)
 }
 
-fn read_args(node: u8, od: Option<&str>, objects: &[&str]) -> sdo::ReadArgs {
-    sdo::ReadArgs {
+/// Node `node` on the bus (500 ms timeout), with `od` (a file in eds/).
+fn to(node: u8, od: Option<&str>) -> sdo::NodeArgs {
+    sdo::NodeArgs {
         bus: bus_args(500),
         node,
         od: od.map(eds),
+    }
+}
+
+/// `sdo write` of `value` to `object` without `--verify`.
+fn write_args(
+    to: sdo::NodeArgs,
+    ty: Option<eds2rust::ir::DataType>,
+    object: &str,
+    value: &str,
+) -> sdo::WriteArgs {
+    sdo::WriteArgs {
+        to,
+        ty,
+        verify: false,
+        object: object.into(),
+        value: value.into(),
+    }
+}
+
+fn read_args(node: u8, od: Option<&str>, objects: &[&str]) -> sdo::ReadArgs {
+    sdo::ReadArgs {
+        to: to(node, od),
         ty: None,
         quiet: false,
         objects: objects.iter().map(|s| s.to_string()).collect(),
@@ -143,13 +166,13 @@ fn sdo_read_raw_and_quiet() {
 fn sdo_write_named_value_unit_and_errors() {
     let sim = zimmer();
     let mut w = sdo::WriteArgs {
-        bus: bus_args(500),
-        node: 40,
-        od: Some(eds("zimmer_acs.yaml")),
-        ty: None,
         verify: true,
-        object: "ModesOfOperation".into(),
-        value: "cyclic synchronous position".into(),
+        ..write_args(
+            to(40, Some("zimmer_acs.yaml")),
+            None,
+            "ModesOfOperation",
+            "cyclic synchronous position",
+        )
     };
     let (out, r) = run(|o| sdo::write(|| Ok(sim.bus()), &w, o));
     r.unwrap();
@@ -174,7 +197,7 @@ fn sdo_write_named_value_unit_and_errors() {
         "{r:?}"
     );
     // Without --od the type is needed.
-    w.od = None;
+    w.to.od = None;
     w.object = "0x6060".into();
     let (_, r) = run(|o| sdo::write(|| Ok(LiveBus::new(Box::new(NoBus))), &w, o));
     assert!(
@@ -182,7 +205,7 @@ fn sdo_write_named_value_unit_and_errors() {
         "{r:?}"
     );
     // A value out of range.
-    w.od = Some(eds("zimmer_acs.yaml"));
+    w.to.od = Some(eds("zimmer_acs.yaml"));
     w.object = "0x6060".into();
     w.value = "300".into();
     let (_, r) = run(|o| sdo::write(|| Ok(LiveBus::new(Box::new(NoBus))), &w, o));
@@ -195,15 +218,12 @@ fn sdo_write_named_value_unit_and_errors() {
 #[test]
 fn sdo_errors_name_node_object_and_abort_code() {
     let sim = zimmer();
-    let w = sdo::WriteArgs {
-        bus: bus_args(500),
-        node: 40,
-        od: None,
-        ty: Some(eds2rust::ir::DataType::Unsigned16),
-        verify: false,
-        object: "0x6041".into(),
-        value: "1".into(),
-    };
+    let w = write_args(
+        to(40, None),
+        Some(eds2rust::ir::DataType::Unsigned16),
+        "0x6041",
+        "1",
+    );
     let (_, r) = run(|o| sdo::write(|| Ok(sim.bus()), &w, o));
     let Err(LiveError::Failed(m)) = r else {
         panic!("{r:?}")
@@ -214,10 +234,8 @@ fn sdo_errors_name_node_object_and_abort_code() {
          (attempt to write a read only object)"
     );
     let sim = zimmer();
-    let a = sdo::ReadArgs {
-        bus: bus_args(50),
-        ..read_args(41, None, &["0x1000"])
-    };
+    let mut a = read_args(41, None, &["0x1000"]);
+    a.to.bus = bus_args(50);
     let (_, r) = run(|o| sdo::read(|| Ok(sim.bus()), &a, o));
     assert_eq!(
         r,
@@ -243,15 +261,12 @@ impl eds2rust_runtime::transport::Bus for NoBus {
 fn nmt_and_scan() {
     let sim = Sim::start(linak_techline::simulator);
     // Heartbeats every 100 ms: the scan hears the state.
-    let hb = sdo::WriteArgs {
-        bus: bus_args(500),
-        node: 32,
-        od: None,
-        ty: Some(eds2rust::ir::DataType::Unsigned16),
-        verify: false,
-        object: "0x1017".into(),
-        value: "100".into(),
-    };
+    let hb = write_args(
+        to(32, None),
+        Some(eds2rust::ir::DataType::Unsigned16),
+        "0x1017",
+        "100",
+    );
     run(|o| sdo::write(|| Ok(sim.bus()), &hb, o)).1.unwrap();
     let scan_args = ScanArgs {
         bus: bus_args(500),
@@ -361,15 +376,7 @@ fn od_upload_then_download_restores_a_changed_value() {
     assert!(at("write 0x1800.1") < at("write 0x6060"));
 
     // Change a value on the node, then download the backup.
-    let w = sdo::WriteArgs {
-        bus: bus_args(500),
-        node: 40,
-        od: Some(eds("zimmer_acs.yaml")),
-        ty: None,
-        verify: false,
-        object: "0x6060".into(),
-        value: "8".into(),
-    };
+    let w = write_args(to(40, Some("zimmer_acs.yaml")), None, "0x6060", "8");
     let (_, r) = run(|o| sdo::write(|| Ok(sim.bus()), &w, o));
     r.unwrap();
     let down = backup::DownloadArgs {
@@ -507,9 +514,7 @@ fn lss_fastscan_and_set_node_id() {
     let file = dir.join("catalogue.txt");
     std::fs::write(&file, "CAT-0123456789-ABCDEFGHIJ").unwrap();
     let d = sdo::DownloadFileArgs {
-        bus: bus_args(500),
-        node: 5,
-        od: Some(eds("interroll_ec5000bi.yaml")),
+        to: to(5, Some("interroll_ec5000bi.yaml")),
         segmented: false,
         object: "Motor Catalogue Number".into(),
         file: file.clone(),

@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::Args;
-use eds2rust::diag::Diagnostics;
 use eds2rust::network::dcf::OutputFile;
 
 use crate::ReadArgs;
+use crate::refusal::failed;
 
 #[derive(Args)]
 pub(crate) struct DcfArgs {
@@ -37,13 +37,13 @@ pub(crate) fn run(args: DcfArgs) -> ExitCode {
     let loaded = eds2rust::network::read_file(&args.bus, &options);
     let mut diagnostics = loaded.diagnostics;
     let Some(bus) = loaded.bus else {
-        return not_written(&args.bus, diagnostics);
+        return failed(&args.bus, diagnostics, "written");
     };
     let (configured, mut configure_diagnostics) = eds2rust::network::configure(&bus);
     configure_diagnostics.apply_levels(&options.levels, options.strict);
     diagnostics.extend(configure_diagnostics);
     if diagnostics.has_errors() {
-        return not_written(&args.bus, diagnostics);
+        return failed(&args.bus, diagnostics, "written");
     }
     let written = eds2rust::network::dcf::files(&bus, &configured, args.remote_pdo);
     let mut err = std::io::stderr().lock();
@@ -102,19 +102,4 @@ fn check_names(files: &[OutputFile]) -> Result<(), String> {
         }
     }
     Ok(())
-}
-
-/// Prints the diagnostics, errors first, then `BUS: not written: N errors`;
-/// exit status 1.
-fn not_written(bus: &Path, mut diagnostics: Diagnostics) -> ExitCode {
-    diagnostics.errors_first();
-    let mut err = std::io::stderr().lock();
-    let _ = write!(err, "{}", diagnostics.render());
-    let _ = writeln!(
-        err,
-        "{}: not written: {} errors",
-        bus.display(),
-        diagnostics.error_count().max(1)
-    );
-    ExitCode::from(1)
 }

@@ -2,7 +2,6 @@
 //! that review, boot or watch a network start from (`diff`/`api` of bus
 //! files, `net boot`, `monitor --bus`, `decode --bus`).
 
-use std::io::Write;
 use std::path::Path;
 
 use eds2rust::diag::Diagnostics;
@@ -44,15 +43,7 @@ pub(crate) fn read_configured(path: &Path, options: &Options, what: &str) -> Opt
             warnings: diagnostics,
         }),
         _ => {
-            diagnostics.errors_first();
-            let mut err = std::io::stderr().lock();
-            let _ = write!(err, "{}", diagnostics.render());
-            let _ = writeln!(
-                err,
-                "{}: not {what}: {} errors",
-                path.display(),
-                diagnostics.error_count().max(1)
-            );
+            crate::refusal::refuse(path, diagnostics, what);
             None
         }
     }

@@ -86,6 +86,6 @@ pub(crate) fn api(path: &Path, overlays: &[PathBuf], options: &Options) -> ExitC
                 Err(code) => code,
             }
         }
-        Err(diagnostics) => crate::failed(path, diagnostics, "listed"),
+        Err(diagnostics) => crate::refusal::failed(path, diagnostics, "listed"),
     }
 }

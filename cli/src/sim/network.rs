@@ -14,24 +14,17 @@ use std::sync::atomic::AtomicBool;
 use eds2rust_runtime::transport::Bus;
 use eds2rust_sim::network::{Event, Network, NodeFault, Simulation};
 
-use super::{Labels, Runner, SimArgs, event_line, fault, not_simulated, open};
+use super::{Labels, Runner, SimArgs, event_line, fault, open, read_input};
 use crate::live::od::Od;
 
 /// Runs `--network BUS`; the exit status (as `eds2rust sim FILE`).
 pub fn run(args: &SimArgs, bus_file: &Path) -> ExitCode {
     let mut err = io::stderr();
-    let network = match Network::load(bus_file) {
+    let loaded = Network::load(bus_file);
+    let network = match read_input(bus_file, loaded, |n| &n.warnings, args.quiet, &mut err) {
         Ok(network) => network,
-        Err(e) => {
-            not_simulated(bus_file, &e, &mut err);
-            return ExitCode::from(1);
-        }
+        Err(code) => return code,
     };
-    if !args.quiet {
-        for line in &network.warnings {
-            let _ = writeln!(err, "{line}");
-        }
-    }
     let faults = match faults(args, &network) {
         Ok(faults) => faults,
         Err(message) => {
