@@ -2,7 +2,7 @@
 
 mod common;
 
-use common::{example, run, seed, tempdir};
+use common::{example, run, seed, temp_file};
 
 #[test]
 fn api_lists_the_generated_api_or_errors() {
@@ -19,15 +19,12 @@ fn api_lists_the_generated_api_or_errors() {
     assert!(stdout.contains("\npdo::Tpdo1Feedback\t0x1A00\ttpdo 1\t8 bytes\tposition@0..16:"));
 
     // An overlay changes the line of the entry it changes, and only that.
-    let dir = tempdir();
-    let overlay = dir.join("api_overlay.yaml");
-    std::fs::write(
-        &overlay,
+    let overlay = temp_file(
+        "api_overlay.yaml",
         "format: 1\nmodify:\n  - { index: 0x6060, access: ro }\n",
-    )
-    .unwrap();
+    );
     let (_, before, _) = run(&["api", &example()]);
-    let (code, after, stderr) = run(&["api", "--overlay", overlay.to_str().unwrap(), &example()]);
+    let (code, after, stderr) = run(&["api", "--overlay", &overlay, &example()]);
     assert_eq!(code, 0, "{stderr}");
     let changed: Vec<_> = before
         .lines()
@@ -41,9 +38,10 @@ fn api_lists_the_generated_api_or_errors() {
     );
 
     // Warnings on stderr and the listing on stdout; errors: exit 1, no listing.
-    let warn = dir.join("api_warn.eds");
-    std::fs::write(&warn, "[1000]\nParameterName=Device type\nDataType=0x0007\nAccessType=ro\nDefaultValue=017\nDefaultValue=0x10\n").unwrap();
-    let warn = warn.to_str().unwrap();
+    let warn = &temp_file(
+        "api_warn.eds",
+        "[1000]\nParameterName=Device type\nDataType=0x0007\nAccessType=ro\nDefaultValue=017\nDefaultValue=0x10\n",
+    );
     let listing = "od::DeviceType\t0x1000\tu32\tro\t-\t-\n";
     let (code, stdout, stderr) = run(&["api", warn]);
     assert_eq!((code, stdout.as_str()), (0, listing), "{stderr}");
@@ -56,13 +54,10 @@ fn api_lists_the_generated_api_or_errors() {
     ];
     let (code, stdout, stderr) = run(&[&["api", "--strict"], &allow[..], &[warn]].concat());
     assert_eq!((code, stdout.as_str(), stderr.as_str()), (0, listing, ""));
-    let bad = dir.join("api_bad.yaml");
-    std::fs::write(
-        &bad,
+    let bad = &temp_file(
+        "api_bad.yaml",
         "format: 1\nobjects:\n  - { index: 0x2000, name: A, type: UINT16, access: rw }\n",
-    )
-    .unwrap();
-    let bad = bad.to_str().unwrap();
+    );
     for args in [
         vec!["api", "--strict", warn],
         vec!["api", "--deny", "eds::duplicate-key", warn],

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{example, run, seed, tempdir};
+use common::{example, run, seed, temp_file, tempdir};
 use serde_json::Value;
 
 #[test]
@@ -217,20 +217,12 @@ fn yaml_tables_are_checked_dumped_and_exported_like_eds() {
     assert_eq!(code, 0, "{stdout}");
 
     // A table with errors: exit 1, the diagnostics on stderr, nothing written.
-    let bad = dir.join("bad.yaml");
-    std::fs::write(
-        &bad,
+    let bad = temp_file(
+        "bad.yaml",
         "format: 1\ndevice: { vendor_name: V, product_name: P }\nobjects:\n  - { index: 0x2000, name: A, type: UINT16, access: rw }\n",
-    )
-    .unwrap();
-    let kept = dir.join("kept.eds");
-    std::fs::write(&kept, "previous").unwrap();
-    let (code, stdout, stderr) = run(&[
-        "export",
-        "-o",
-        kept.to_str().unwrap(),
-        bad.to_str().unwrap(),
-    ]);
+    );
+    let kept = temp_file("kept.eds", "previous");
+    let (code, stdout, stderr) = run(&["export", "-o", &kept, &bad]);
     assert_eq!(code, 1);
     assert!(stdout.is_empty(), "{stdout}");
     assert!(

@@ -5,26 +5,28 @@
 
 mod common;
 
-use std::path::PathBuf;
-use std::process::Command;
-
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+use common::{root, row};
 
 /// Runs the binary in the workspace root (paths in the output are as
 /// given): exit code, stdout, stderr.
 fn run(args: &[&str]) -> (i32, String, String) {
-    let out = Command::new(common::BIN)
-        .args(args)
-        .current_dir(root())
-        .output()
-        .expect("run eds2rust");
-    (
-        out.status.code().expect("exit code"),
-        String::from_utf8(out.stdout).unwrap(),
-        String::from_utf8(out.stderr).unwrap(),
-    )
+    common::run_in(&root(), args)
+}
+
+/// `net boot --simulate --run --duration DURATION` of the fault-matrix
+/// network with `fault`, then `more` arguments.
+fn run_matrix(fault: &str, duration: &str, more: &[&str]) -> (i32, String, String) {
+    let args = [
+        "net",
+        "boot",
+        "--simulate",
+        "--fault",
+        fault,
+        "--run",
+        "--duration",
+        duration,
+    ];
+    run(&[&args[..], more, &["tests/networks/boot/matrix.yml"]].concat())
 }
 
 #[test]
@@ -106,18 +108,7 @@ fn a_missing_mandatory_slave_fails_the_boot_with_status_b() {
         "tests/networks/boot/matrix.yml",
     ]);
     assert_eq!(code, 1, "{stdout}{stderr}");
-    let row = |node: &str| -> Vec<String> {
-        stdout
-            .lines()
-            .map(|l| {
-                l.trim_matches('|')
-                    .split('|')
-                    .map(|c| c.trim().to_string())
-                    .collect::<Vec<_>>()
-            })
-            .find(|cells| cells.first().is_some_and(|c| c == node))
-            .unwrap_or_else(|| panic!("no row of node {node}:\n{stdout}"))
-    };
+    let row = |node: &str| row(&stdout, node);
     assert_eq!(
         row("2"),
         [
@@ -229,17 +220,7 @@ fn usage_and_input_errors() {
 /// each; the end is all operational: exit status 0.
 #[test]
 fn run_keeps_the_network_and_boots_a_returning_slave_again() {
-    let (code, stdout, stderr) = run(&[
-        "net",
-        "boot",
-        "--simulate",
-        "--fault",
-        "left:power-loss=1s+300ms",
-        "--run",
-        "--duration",
-        "2s",
-        "tests/networks/boot/matrix.yml",
-    ]);
+    let (code, stdout, stderr) = run_matrix("left:power-loss=1s+300ms", "2s", &[]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     let after: Vec<&str> = stdout
         .lines()
@@ -263,19 +244,7 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
     );
     assert!(stderr.contains("running the network for 2.0 s"), "{stderr}");
 
-    let (code, stdout, _) = run(&[
-        "net",
-        "boot",
-        "--simulate",
-        "--fault",
-        "left:power-loss=1s+300ms",
-        "--run",
-        "--duration",
-        "2s",
-        "--format",
-        "json",
-        "tests/networks/boot/matrix.yml",
-    ]);
+    let (code, stdout, _) = run_matrix("left:power-loss=1s+300ms", "2s", &["--format", "json"]);
     assert_eq!(code, 0, "{stdout}");
     let v: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON object");
     let events: Vec<&str> = v["events"]
@@ -290,17 +259,7 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
 
     // The mandatory slave boots after the boot time (1 s): the network's
     // boot failed (B); booted when it comes, it is not started: exit 1.
-    let (code, stdout, _) = run(&[
-        "net",
-        "boot",
-        "--simulate",
-        "--fault",
-        "left:late-boot=1500ms",
-        "--run",
-        "--duration",
-        "3s",
-        "tests/networks/boot/matrix.yml",
-    ]);
+    let (code, stdout, _) = run_matrix("left:late-boot=1500ms", "3s", &[]);
     assert_eq!(code, 1, "{stdout}");
     assert!(
         stdout.contains("left (node 2): booting again\n")

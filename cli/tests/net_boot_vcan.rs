@@ -11,8 +11,10 @@
 //! directory (the VM has no checkout).
 #![cfg(target_os = "linux")]
 
+mod common;
 mod vcan;
 
+use common::row;
 use vcan::{Running, iface, ok, scratch};
 
 /// The index of this test's interface in `CAN_IFACES`: monitor_vcan's
@@ -43,20 +45,6 @@ fn machine() -> String {
     let bus = dir.join("machine/bus.yml");
     std::fs::write(&bus, BUS).unwrap();
     bus.display().to_string()
-}
-
-/// The cells of the table row whose first cell is `node`.
-fn row(stdout: &str, node: &str) -> Vec<String> {
-    stdout
-        .lines()
-        .map(|l| {
-            l.trim_matches('|')
-                .split('|')
-                .map(|c| c.trim().to_string())
-                .collect::<Vec<_>>()
-        })
-        .find(|cells| cells.first().is_some_and(|c| c == node))
-        .unwrap_or_else(|| panic!("no row of node {node}:\n{stdout}"))
 }
 
 #[test]

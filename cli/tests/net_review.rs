@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{example, run, tempdir};
+use common::{example, run, temp_file};
 use serde_json::Value;
 
 fn bus(side: &str) -> String {
@@ -103,15 +103,11 @@ fn diff_refuses_a_bus_file_against_a_device_and_overlays() {
     assert_eq!(code, 2);
     assert!(stderr.contains("not to bus files"), "{stderr}");
     // A broken bus file: its diagnostics, exit 2 as for a broken device.
-    let dir = tempdir().join("net-review");
-    std::fs::create_dir_all(&dir).unwrap();
-    let broken = dir.join("bus.yml");
-    std::fs::write(
-        &broken,
+    let broken = temp_file(
+        "net-review/bus.yml",
         "master:\n  node_id: 1\naxis:\n  dcf: absent.eds\n  node_id: 2\n",
-    )
-    .unwrap();
-    let (code, stdout, stderr) = run(&["diff", &bus("old"), broken.to_str().unwrap()]);
+    );
+    let (code, stdout, stderr) = run(&["diff", &bus("old"), &broken]);
     assert_eq!(code, 2, "{stdout}");
     assert!(
         stdout.is_empty() && stderr.contains("not compared"),

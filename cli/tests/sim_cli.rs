@@ -7,12 +7,12 @@
 
 mod common;
 
-use common::{example, run, seed, tempdir};
+use common::{assert_usage_errors, example, run, seed, temp_file};
 
 #[test]
 fn usage_errors_exit_2() {
     let eds = example();
-    for (args, says) in [
+    assert_usage_errors(&[
         (vec!["sim"], "required arguments were not provided"),
         (vec!["sim", eds.as_str()], "--iface <IFACE>"),
         (
@@ -44,12 +44,7 @@ fn usage_errors_exit_2() {
             vec!["sim", eds.as_str(), "-i", "can0", "--time-scale", "0"],
             "`0` is not a positive factor",
         ),
-    ] {
-        let (code, out, err) = run(&args);
-        assert_eq!(code, 2, "{args:?}: {err}");
-        assert!(out.is_empty(), "{args:?}: {out}");
-        assert!(err.contains(says), "{args:?}: no {says:?} in {err}");
-    }
+    ]);
 }
 
 #[test]
@@ -76,14 +71,10 @@ fn help_lists_the_options() {
 
 #[test]
 fn an_overlay_that_does_not_read_is_named_with_its_line() {
-    let dir = tempdir();
-    let overlay = dir.join("sim-bad-overlay.yaml");
-    std::fs::write(
-        &overlay,
+    let overlay = temp_file(
+        "sim-bad-overlay.yaml",
         "format: 1\nmodify:\n  - { index: 0x1017, default: 50 }\n  - { index: 0x7777, name: Nowhere }\n",
-    )
-    .unwrap();
-    let overlay = overlay.display().to_string();
+    );
     let (code, out, err) = run(&[
         "sim",
         &example(),
@@ -104,16 +95,12 @@ fn an_overlay_that_does_not_read_is_named_with_its_line() {
 
 #[test]
 fn a_file_that_does_not_read_prints_its_diagnostics_and_exits_1() {
-    let dir = tempdir();
-    let bad = dir.join("sim-bad.eds");
-    std::fs::write(
-        &bad,
+    let bad = temp_file(
+        "sim-bad.eds",
         "[DeviceInfo]\nProductName=X\n\n[MandatoryObjects]\nSupportedObjects=1\n1=0x1000\n\n\
          [1000]\nParameterName=Device Type\nObjectType=0x07\nDataType=0xZZ\nAccessType=ro\n\
          DefaultValue=0\nPDOMapping=0\n",
-    )
-    .unwrap();
-    let bad = bad.display().to_string();
+    );
     // The file is read before the interface is opened.
     let (code, out, err) = run(&["sim", &bad, "-i", "nosuchcan0", "-n", "3"]);
     assert_eq!(code, 1, "{err}");

@@ -6,7 +6,7 @@
 
 mod common;
 
-use common::{run, tempdir};
+use common::{assert_usage_errors, run, temp_file};
 
 fn bus() -> String {
     format!(
@@ -19,7 +19,7 @@ fn bus() -> String {
 fn usage_errors_exit_2() {
     let bus = bus();
     let eds = common::example();
-    for (args, says) in [
+    assert_usage_errors(&[
         (vec!["sim", "--network", bus.as_str()], "--iface <IFACE>"),
         (
             vec!["sim", eds.as_str(), "--network", bus.as_str(), "-i", "can0"],
@@ -33,12 +33,7 @@ fn usage_errors_exit_2() {
             vec!["sim", eds.as_str(), "-i", "can0", "--fault", "2:missing"],
             "--network <BUS>",
         ),
-    ] {
-        let (code, out, err) = run(&args);
-        assert_eq!(code, 2, "{args:?}: {err}");
-        assert!(out.is_empty(), "{args:?}: {out}");
-        assert!(err.contains(says), "{args:?}: no {says:?} in {err}");
-    }
+    ]);
 }
 
 #[test]
@@ -96,18 +91,14 @@ fn a_bad_fault_is_named_with_what_is_allowed() {
 #[test]
 fn a_fault_that_does_not_fit_the_network_says_what_to_do() {
     // config-current needs the slave's configuration to carry 0x1020.
-    let dir = tempdir();
-    let file = dir.join("sim-network-no-date.yml");
     let device = format!(
         "{}/../tests/networks/boot/drive.yaml",
         env!("CARGO_MANIFEST_DIR")
     );
-    std::fs::write(
-        &file,
+    let file = temp_file(
+        "sim-network-no-date.yml",
         format!("master:\n  node_id: 1\n\nonly:\n  dcf: {device}\n  node_id: 4\n"),
-    )
-    .unwrap();
-    let file = file.display().to_string();
+    );
     let (code, _, err) = run(&[
         "sim",
         "--network",
@@ -127,14 +118,10 @@ fn a_fault_that_does_not_fit_the_network_says_what_to_do() {
 
 #[test]
 fn a_bus_file_that_does_not_read_names_file_line_and_key() {
-    let dir = tempdir();
-    let file = dir.join("sim-network-bad.yml");
-    std::fs::write(
-        &file,
+    let file = temp_file(
+        "sim-network-bad.yml",
         "master:\n  node_id: 1\n\nleft:\n  dcf: no-such-device.eds\n  node_id: 2\n",
-    )
-    .unwrap();
-    let file = file.display().to_string();
+    );
     let (code, out, err) = run(&["sim", "--network", &file, "-i", "nosuchcan0"]);
     assert_eq!(code, 1, "{err}");
     assert!(out.is_empty(), "{out}");

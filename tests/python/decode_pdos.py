@@ -38,16 +38,8 @@ from importlib.metadata import version
 
 import canopen
 
-
-class Collect(logging.Handler):
-    """Collects the warnings python-canopen logs (e.g. a mapped entry it lacks)."""
-
-    def __init__(self):
-        super().__init__(level=logging.WARNING)
-        self.messages = []
-
-    def emit(self, record):
-        self.messages.append(record.getMessage())
+# Collects the warnings python-canopen logs (e.g. a mapped entry it lacks).
+from od_dump import Collect
 
 
 def tagged(value):

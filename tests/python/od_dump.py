@@ -90,14 +90,17 @@ def dump(path, node_id):
     return {"file": path, "ok": True, "error": None, "warnings": collect.messages, "entries": entries}
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+def per_file_main(doc, one_file):
+    """The command line of a per-file oracle: `--node-id N FILE...`, and
+    `one_file(path, node_id)` printed as one JSON line per file; `doc` is
+    the script's docstring (its first line is the description)."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
     parser.add_argument("--node-id", type=int, required=True)
     parser.add_argument("files", nargs="+")
     args = parser.parse_args()
     for path in args.files:
-        sys.stdout.write(json.dumps(dump(path, args.node_id)) + "\n")
+        sys.stdout.write(json.dumps(one_file(path, args.node_id)) + "\n")
 
 
 if __name__ == "__main__":
-    main()
+    per_file_main(__doc__, dump)

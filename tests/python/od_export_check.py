@@ -9,16 +9,13 @@ entry python-canopen models (od_dump.entries_of, in the schema of
 log records of WARNING and above from any logger, and Python `warnings`.
 """
 
-import argparse
-import json
 import logging
-import sys
 import warnings
 
 import canopen
 
 # The entries in the dump's JSON form, exactly as the differential test's oracle writes them.
-from od_dump import entries_of
+from od_dump import entries_of, per_file_main
 
 
 class Collect(logging.Handler):
@@ -56,14 +53,5 @@ def load(path, node_id):
     return {"file": path, "ok": True, "error": None, "warnings": messages, "entries": entries}
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--node-id", type=int, required=True)
-    parser.add_argument("files", nargs="+")
-    args = parser.parse_args()
-    for path in args.files:
-        sys.stdout.write(json.dumps(load(path, args.node_id)) + "\n")
-
-
 if __name__ == "__main__":
-    main()
+    per_file_main(__doc__, load)

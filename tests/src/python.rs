@@ -152,3 +152,120 @@ pub fn same_value(
         _ => ours == theirs,
     }
 }
+
+/// Runs a per-file oracle (`od_dump.py`, `od_export_check.py`: `--node-id
+/// N FILE...`, one JSON line per file) on `paths`; one result per path, in
+/// order (checked by its `file`).
+pub fn run_per_file(script: &str, paths: &[&Path], node_id: u8) -> Vec<serde_json::Value> {
+    let node = node_id.to_string();
+    let out = run_script(script, paths, &["--node-id", &node])
+        .unwrap_or_else(|e| panic!("the python-canopen oracle could not run: {e}"));
+    let results: Vec<serde_json::Value> = out
+        .lines()
+        .filter(|l| !l.trim().is_empty())
+        .map(|l| {
+            serde_json::from_str(l).unwrap_or_else(|e| panic!("{script} prints JSON lines: {e}"))
+        })
+        .collect();
+    assert_eq!(results.len(), paths.len(), "one result per file");
+    for (path, result) in paths.iter().zip(&results) {
+        assert_eq!(
+            result["file"].as_str(),
+            path.to_str(),
+            "results come in file order"
+        );
+    }
+    results
+}
+
+/// How python-canopen's entries compare with ours, entry by entry.
+#[derive(Default)]
+pub struct Agreement {
+    /// Entries python-canopen has.
+    pub compared: usize,
+    /// Entries equal on every compared field.
+    pub agreed: usize,
+    /// Entries that differ only as a rule explains, by the first rule.
+    pub by_rule: std::collections::BTreeMap<&'static str, usize>,
+    /// `NAME 0xINDEX sub SUB: ...` of every other entry.
+    pub unexplained: Vec<String>,
+}
+
+impl Agreement {
+    /// Compares python-canopen's `entries` (in the dump's JSON schema) of
+    /// the file `name` with ours: `ours` is `eds2rust dump --format json`
+    /// of `device`. Each entry agrees on every [`COMPARED_FIELDS`] field
+    /// ([`same_value`]), or differs as `explain(index, entry, field, ours,
+    /// theirs)` names a rule for every differing field, or is unexplained.
+    /// python-canopen's dummy objects (0x0001..=0x0007) count as the rule
+    /// `dummy-objects`.
+    pub fn compare(
+        &mut self,
+        name: &str,
+        device: &eds2rust::ir::Device,
+        ours: &serde_json::Value,
+        entries: &serde_json::Value,
+        explain: impl Fn(
+            u16,
+            &eds2rust::ir::Entry,
+            &str,
+            &serde_json::Value,
+            &serde_json::Value,
+        ) -> Option<&'static str>,
+    ) {
+        let key = |e: &serde_json::Value| (e["index"].as_u64(), e["subindex"].as_u64());
+        let ours_by_key: std::collections::BTreeMap<_, &serde_json::Value> = ours["entries"]
+            .as_array()
+            .into_iter()
+            .flatten()
+            .map(|e| (key(e), e))
+            .collect();
+        for theirs in entries.as_array().into_iter().flatten() {
+            let (Some(index), Some(sub)) = key(theirs) else {
+                panic!("{name}: python entry without index: {theirs}");
+            };
+            let where_ = format!("{name} 0x{index:04X} sub {sub}");
+            self.compared += 1;
+            if (1..=7).contains(&index)
+                && theirs["name"]
+                    .as_str()
+                    .is_some_and(|n| n.starts_with("Dummy"))
+            {
+                *self.by_rule.entry("dummy-objects").or_default() += 1;
+                continue;
+            }
+            let entry = u16::try_from(index)
+                .ok()
+                .and_then(|i| device.objects.get(&i))
+                .and_then(|o| o.entries.get(&u8::try_from(sub).ok()?));
+            let (Some(our), Some(entry)) = (ours_by_key.get(&(Some(index), Some(sub))), entry)
+            else {
+                self.unexplained.push(format!(
+                    "{where_}: python-canopen has `{}`, eds2rust has no such entry",
+                    theirs["name"]
+                ));
+                continue;
+            };
+            let mut rules = Vec::new();
+            let mut mismatch = Vec::new();
+            for &field in COMPARED_FIELDS {
+                let (a, b) = (&our[field], &theirs[field]);
+                if same_value(a, b, entry.data_type) {
+                    continue;
+                }
+                match explain(index as u16, entry, field, a, b) {
+                    Some(rule) => rules.push(rule),
+                    None => mismatch.push(format!("{field}: eds2rust {a}, python-canopen {b}")),
+                }
+            }
+            if !mismatch.is_empty() {
+                self.unexplained
+                    .push(format!("{where_}: {}", mismatch.join("; ")));
+            } else if let Some(rule) = rules.first() {
+                *self.by_rule.entry(rule).or_default() += 1;
+            } else {
+                self.agreed += 1;
+            }
+        }
+    }
+}

@@ -22,8 +22,7 @@ use eds2rust::dump::json::to_json;
 use eds2rust::eds::{Options, read_bytes, read_file};
 use eds2rust::r#gen::eds::to_eds;
 use eds2rust::ir::{DataType, Device, Entry, Literal, Origin, Value, ValueKind};
-use eds2rust_tests::python::run_script;
-use eds2rust_tests::python::{COMPARED_FIELDS as FIELDS, same_value};
+use eds2rust_tests::python::{Agreement, run_per_file};
 use serde_json::Value as Json;
 
 /// What an export → read cycle changes, by design or by a stated limit.
@@ -404,32 +403,13 @@ struct PythonCheck {
     /// reader, which does not know that section).
     unknown_type_warnings: Vec<(String, String)>,
     loaded: usize,
-    compared: usize,
-    agreed: usize,
-    by_rule: BTreeMap<&'static str, usize>,
-    unexplained: Vec<String>,
+    entries: Agreement,
 }
 
 /// Runs `od_export_check.py` on `paths`; one JSON result per path, in order.
 fn python_load(paths: &[PathBuf]) -> Vec<Json> {
     let args: Vec<&Path> = paths.iter().map(PathBuf::as_path).collect();
-    let node = NODE_ID.to_string();
-    let out = run_script("od_export_check.py", &args, &["--node-id", &node])
-        .unwrap_or_else(|e| panic!("the python-canopen oracle could not run: {e}"));
-    let results: Vec<Json> = out
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| serde_json::from_str(l).expect("od_export_check.py prints JSON lines"))
-        .collect();
-    assert_eq!(results.len(), paths.len(), "one result per file");
-    for (path, result) in paths.iter().zip(&results) {
-        assert_eq!(
-            result["file"].as_str(),
-            path.to_str(),
-            "results in file order"
-        );
-    }
-    results
+    run_per_file("od_export_check.py", &args, NODE_ID)
 }
 
 /// The file an export of `name` is written to (python-canopen wants .eds or .dcf).
@@ -479,65 +459,6 @@ fn explain(entry: &Entry, field: &str, theirs: &Json) -> Option<&'static str> {
     }
 }
 
-/// Compares python-canopen's entries of one export with our reading of it.
-fn compare_export(name: &str, export: &Device, python: &Json, check: &mut PythonCheck) {
-    let ours = to_json(name, Some(export), &Diagnostics::new(), Some(NODE_ID));
-    let key = |e: &Json| (e["index"].as_u64(), e["subindex"].as_u64());
-    let ours_by_key: BTreeMap<_, &Json> = ours["entries"]
-        .as_array()
-        .into_iter()
-        .flatten()
-        .map(|e| (key(e), e))
-        .collect();
-    for theirs in python["entries"].as_array().into_iter().flatten() {
-        let (Some(index), Some(sub)) = key(theirs) else {
-            panic!("{name}: python entry without index: {theirs}");
-        };
-        let where_ = format!("{name} 0x{index:04X} sub {sub}");
-        check.compared += 1;
-        if (1..=7).contains(&index)
-            && theirs["name"]
-                .as_str()
-                .is_some_and(|n| n.starts_with("Dummy"))
-        {
-            *check.by_rule.entry("dummy-objects").or_default() += 1;
-            continue;
-        }
-        let entry = u16::try_from(index)
-            .ok()
-            .and_then(|i| export.objects.get(&i))
-            .and_then(|o| o.entries.get(&u8::try_from(sub).ok()?));
-        let (Some(our), Some(entry)) = (ours_by_key.get(&(Some(index), Some(sub))), entry) else {
-            check.unexplained.push(format!(
-                "{where_}: python-canopen has `{}`, eds2rust has no such entry",
-                theirs["name"]
-            ));
-            continue;
-        };
-        let mut rules = Vec::new();
-        let mut mismatch = Vec::new();
-        for &field in FIELDS {
-            let (a, b) = (&our[field], &theirs[field]);
-            if same_value(a, b, entry.data_type) {
-                continue;
-            }
-            match explain(entry, field, b) {
-                Some(rule) => rules.push(rule),
-                None => mismatch.push(format!("{field}: eds2rust {a}, python-canopen {b}")),
-            }
-        }
-        if !mismatch.is_empty() {
-            check
-                .unexplained
-                .push(format!("{where_}: {}", mismatch.join("; ")));
-        } else if let Some(rule) = rules.first() {
-            *check.by_rule.entry(rule).or_default() += 1;
-        } else {
-            check.agreed += 1;
-        }
-    }
-}
-
 /// Exports every device under the target directory, loads the exports with
 /// python-canopen and compares each entry with our reading of the export.
 /// The caller decides which failures to load are acceptable
@@ -578,7 +499,14 @@ fn check_exports_with_python(devices: &[(String, Device)]) -> PythonCheck {
             continue;
         }
         check.loaded += 1;
-        compare_export(name, export, &python, &mut check);
+        let ours = to_json(name, Some(export), &Diagnostics::new(), Some(NODE_ID));
+        check.entries.compare(
+            name,
+            export,
+            &ours,
+            &python["entries"],
+            |_, entry, field, _, theirs| explain(entry, field, theirs),
+        );
     }
     check
 }
@@ -595,7 +523,7 @@ fn python_canopen_loads_the_exports_without_warnings() {
         .filter_map(|(p, r)| Some((p.file_name()?.to_string_lossy().into_owned(), r)))
         .collect();
     let check = check_exports_with_python(&devices);
-    let explained: usize = check.by_rule.values().sum();
+    let explained: usize = check.entries.by_rule.values().sum();
     let originals_loaded = originals.values().filter(|r| r["ok"] == true).count();
     println!(
         "EDS export python-canopen 2.4.1 check: {} exports ({originals_loaded} originals load), {} loaded, {} warnings (+{} of rule unknown-type), {} entries compared, {} agree, {} explained by a rule, {} unexplained",
@@ -603,13 +531,13 @@ fn python_canopen_loads_the_exports_without_warnings() {
         check.loaded,
         check.warnings.len(),
         check.unknown_type_warnings.len(),
-        check.compared,
-        check.agreed,
+        check.entries.compared,
+        check.entries.agreed,
         explained,
-        check.unexplained.len()
+        check.entries.unexplained.len()
     );
     for (rule, reason) in PYTHON_RULES {
-        if let Some(n) = check.by_rule.get(rule) {
+        if let Some(n) = check.entries.by_rule.get(rule) {
             println!("    {rule:<20} {n:>5}  {reason}");
         }
     }
@@ -656,15 +584,15 @@ fn python_canopen_loads_the_exports_without_warnings() {
         show(&new_unknown)
     );
     assert!(
-        check.unexplained.is_empty(),
+        check.entries.unexplained.is_empty(),
         "{} entries differ without a python-canopen rule:\n{}",
-        check.unexplained.len(),
-        check.unexplained.join("\n")
+        check.entries.unexplained.len(),
+        check.entries.unexplained.join("\n")
     );
     assert!(
-        check.compared > 10_000,
+        check.entries.compared > 10_000,
         "only {} entries compared",
-        check.compared
+        check.entries.compared
     );
 }
 
@@ -714,20 +642,24 @@ fn seed_device_exports_round_trip_and_load_in_python_canopen() {
         check.unknown_type_warnings
     );
     assert!(
-        check.unexplained.is_empty(),
+        check.entries.unexplained.is_empty(),
         "{}",
-        check.unexplained.join("\n")
+        check.entries.unexplained.join("\n")
     );
     assert_eq!(check.loaded, 3);
     // Every entry python-canopen models agrees outright: no rule is needed.
-    assert!(check.by_rule.is_empty(), "rules used: {:?}", check.by_rule);
     assert!(
-        check.compared >= 450,
+        check.entries.by_rule.is_empty(),
+        "rules used: {:?}",
+        check.entries.by_rule
+    );
+    assert!(
+        check.entries.compared >= 450,
         "only {} entries compared",
-        check.compared
+        check.entries.compared
     );
     println!(
         "seed devices: {} entries round-trip, {} compared with python-canopen, {} agree",
-        tally.entries, check.compared, check.agreed
+        tally.entries, check.entries.compared, check.entries.agreed
     );
 }

@@ -7,7 +7,6 @@
 //! one of the rules in [`RULES`] (by what the entry is, never by file name) and
 //! listed with its count. The rule-adjusted agreement must be at least 99.5 %.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
 use eds2rust::diag::Diagnostics;
@@ -15,7 +14,7 @@ use eds2rust::dump::json::to_json;
 use eds2rust::eds::ini::Document;
 use eds2rust::eds::{Options, read_file};
 use eds2rust::ir::{DataType, Device, Entry, Literal, ObjectKind, ValueKind};
-use eds2rust_tests::python::{COMPARED_FIELDS as FIELDS, same_value};
+use eds2rust_tests::python::{Agreement, run_per_file};
 use serde_json::Value;
 
 /// Known python-canopen 2.4.1 behaviours that differ from CiA 306, with the reason.
@@ -162,10 +161,7 @@ fn explain(
 
 #[derive(Default)]
 struct Tally {
-    compared: usize,
-    agreed: usize,
-    by_rule: BTreeMap<&'static str, usize>,
-    unexplained: Vec<String>,
+    entries: Agreement,
     python_failed: Vec<String>,
 }
 
@@ -184,66 +180,13 @@ fn compare_file(path: &Path, python: &Value, tally: &mut Tally) {
     let mut scratch = Diagnostics::new();
     let text = eds2rust::eds::ini::decode(&name, &bytes, &mut scratch);
     let doc = eds2rust::eds::ini::parse(&name, &text, &mut scratch);
-    let ours_by_key: BTreeMap<(u64, u64), &Value> = ours["entries"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|e| {
-            (
-                (
-                    e["index"].as_u64().unwrap(),
-                    e["subindex"].as_u64().unwrap(),
-                ),
-                e,
-            )
-        })
-        .collect();
-    for theirs in python["entries"].as_array().unwrap() {
-        let key = (
-            theirs["index"].as_u64().unwrap(),
-            theirs["subindex"].as_u64().unwrap(),
-        );
-        let where_ = format!("{name} 0x{:04X} sub {}", key.0, key.1);
-        tally.compared += 1;
-        if (1..=7).contains(&key.0)
-            && theirs["name"]
-                .as_str()
-                .is_some_and(|n| n.starts_with("Dummy"))
-        {
-            *tally.by_rule.entry("dummy-objects").or_default() += 1;
-            continue;
-        }
-        let Some(our) = ours_by_key.get(&key) else {
-            tally.unexplained.push(format!(
-                "{where_}: python-canopen has `{}`, eds2rust has no such entry",
-                theirs["name"]
-            ));
-            continue;
-        };
-        let index = key.0 as u16;
-        let entry = &device.objects[&index].entries[&(key.1 as u8)];
-        let mut rules = Vec::new();
-        let mut mismatch = Vec::new();
-        for &field in FIELDS {
-            let (a, b) = (&our[field], &theirs[field]);
-            if same_value(a, b, entry.data_type) {
-                continue;
-            }
-            match explain(&doc, device, index, entry, field, a, b) {
-                Some(rule) => rules.push(rule),
-                None => mismatch.push(format!("{field}: eds2rust {a}, python-canopen {b}")),
-            }
-        }
-        if !mismatch.is_empty() {
-            tally
-                .unexplained
-                .push(format!("{where_}: {}", mismatch.join("; ")));
-        } else if let Some(rule) = rules.first() {
-            *tally.by_rule.entry(rule).or_default() += 1;
-        } else {
-            tally.agreed += 1;
-        }
-    }
+    tally.entries.compare(
+        &name,
+        device,
+        &ours,
+        &python["entries"],
+        |index, entry, field, a, b| explain(&doc, device, index, entry, field, a, b),
+    );
 }
 
 #[test]
@@ -252,25 +195,13 @@ fn python_canopen_agrees_with_dump() {
         return;
     };
     let paths: Vec<&Path> = files.iter().map(|p| p.as_path()).collect();
-    let out = eds2rust_tests::python::run_script("od_dump.py", &paths, &["--node-id", "5"])
-        .unwrap_or_else(|e| panic!("the python-canopen oracle could not run: {e}"));
-    let results: Vec<Value> = out
-        .lines()
-        .filter(|l| !l.trim().is_empty())
-        .map(|l| serde_json::from_str(l).expect("od_dump.py prints JSON lines"))
-        .collect();
-    assert_eq!(results.len(), files.len(), "one result per file");
+    let results = run_per_file("od_dump.py", &paths, 5);
     let mut tally = Tally::default();
     for (path, python) in files.iter().zip(&results) {
-        assert_eq!(
-            python["file"].as_str(),
-            Some(path.to_str().unwrap()),
-            "results come in file order"
-        );
         compare_file(path, python, &mut tally);
     }
-    let explained: usize = tally.by_rule.values().sum();
-    let rate = 100.0 * (tally.agreed + explained) as f64 / tally.compared as f64;
+    let explained: usize = tally.entries.by_rule.values().sum();
+    let rate = 100.0 * (tally.entries.agreed + explained) as f64 / tally.entries.compared as f64;
     println!(
         "python-canopen 2.4.1 differential test over {} files",
         files.len()
@@ -282,31 +213,34 @@ fn python_canopen_agrees_with_dump() {
     for f in &tally.python_failed {
         println!("    {f}");
     }
-    println!("  entries compared: {}", tally.compared);
+    println!("  entries compared: {}", tally.entries.compared);
     println!(
         "  agree on every field: {} ({:.2} %)",
-        tally.agreed,
-        100.0 * tally.agreed as f64 / tally.compared as f64
+        tally.entries.agreed,
+        100.0 * tally.entries.agreed as f64 / tally.entries.compared as f64
     );
     println!("  differences explained by a python-canopen rule: {explained}");
     for (rule, reason) in RULES {
-        if let Some(n) = tally.by_rule.get(rule) {
+        if let Some(n) = tally.entries.by_rule.get(rule) {
             println!("    {rule:<20} {n:>5}  {reason}");
         }
     }
-    println!("  unexplained differences: {}", tally.unexplained.len());
-    for u in &tally.unexplained {
+    println!(
+        "  unexplained differences: {}",
+        tally.entries.unexplained.len()
+    );
+    for u in &tally.entries.unexplained {
         println!("    {u}");
     }
     println!("  agreement (agree + explained): {rate:.2} %");
     assert!(
-        tally.compared > 10_000,
+        tally.entries.compared > 10_000,
         "the corpus should give over 10 000 comparable entries, got {}",
-        tally.compared
+        tally.entries.compared
     );
     assert!(
         rate >= 99.5,
         "agreement {rate:.2} % is below 99.5 %; unexplained:\n{}",
-        tally.unexplained.join("\n")
+        tally.entries.unexplained.join("\n")
     );
 }

@@ -112,6 +112,19 @@ pub fn targets(od: Option<&Od>, text: &str) -> Result<Vec<(u16, u8)>, LiveError>
     }
 }
 
+/// The one (index, sub) pair of an object argument ([`targets`]); a usage
+/// error worded by `too_many` when it names several.
+fn one_target(
+    od: Option<&Od>,
+    text: &str,
+    too_many: impl FnOnce(&[(u16, u8)]) -> String,
+) -> Result<(u16, u8), LiveError> {
+    match targets(od, text)?.as_slice() {
+        [one] => Ok(*one),
+        many => Err(LiveError::Usage(too_many(many))),
+    }
+}
+
 /// How a node, an object and the transfer's error read in a message.
 pub fn transfer_error(
     node: NodeId,
@@ -244,17 +257,14 @@ pub fn report_failures(failed: Vec<LiveError>) -> Result<(), LiveError> {
 
 pub fn write(open: impl Opener, a: &WriteArgs, out: &mut dyn Write) -> Result<(), LiveError> {
     let (od, node) = a.to.load()?;
-    let (index, sub) = match targets(od.as_ref(), &a.object)?.as_slice() {
-        [one] => *one,
-        many => {
-            return Err(LiveError::Usage(format!(
-                "`{}` names {} entries; write one at a time (e.g. {})",
-                a.object,
-                many.len(),
-                many.get(1).map_or(String::new(), |(i, s)| od::key(*i, *s))
-            )));
-        }
-    };
+    let (index, sub) = one_target(od.as_ref(), &a.object, |many| {
+        format!(
+            "`{}` names {} entries; write one at a time (e.g. {})",
+            a.object,
+            many.len(),
+            many.get(1).map_or(String::new(), |(i, s)| od::key(*i, *s))
+        )
+    })?;
     let label = label(od.as_ref(), index, sub);
     if let Some((_, entry)) = od.as_ref().and_then(|od| od.entry(index, sub))
         && !entry.access.is_writable()
@@ -315,15 +325,9 @@ pub fn download_file(
     out: &mut dyn Write,
 ) -> Result<(), LiveError> {
     let (od, node) = a.to.load()?;
-    let (index, sub) = match targets(od.as_ref(), &a.object)?.as_slice() {
-        [one] => *one,
-        _ => {
-            return Err(LiveError::Usage(format!(
-                "`{}` names more than one entry",
-                a.object
-            )));
-        }
-    };
+    let (index, sub) = one_target(od.as_ref(), &a.object, |_| {
+        format!("`{}` names more than one entry", a.object)
+    })?;
     let label = label(od.as_ref(), index, sub);
     let cannot_read =
         |e: std::io::Error| LiveError::Usage(format!("cannot read {}: {e}", a.file.display()));
