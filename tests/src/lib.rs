@@ -45,6 +45,44 @@ pub fn corpus_files(what: &str) -> Option<Vec<PathBuf>> {
     Some(files)
 }
 
+/// `../shared/network-corpus`; `None` (after printing one line that names
+/// what did not run) when it is absent.
+pub fn network_corpus(what: &str) -> Option<PathBuf> {
+    let Some(shared) = shared_dir() else {
+        not_run(&format!(
+            "{what}: ../shared/network-corpus is not beside this checkout"
+        ));
+        return None;
+    };
+    Some(shared.join("network-corpus"))
+}
+
+/// The bus file at `path` read and configured, neither with an error
+/// (the test fails with the diagnostics otherwise).
+pub fn configured_network(
+    path: &Path,
+) -> (
+    eds2rust::network::model::Bus,
+    eds2rust::network::config::Configured,
+) {
+    let loaded = eds2rust::network::read_file(path, &eds2rust::read::Options::default());
+    assert!(
+        !loaded.diagnostics.has_errors(),
+        "{}:\n{}",
+        path.display(),
+        loaded.diagnostics.render()
+    );
+    let bus = loaded.bus.expect("a bus");
+    let (configured, diagnostics) = eds2rust::network::configure(&bus);
+    assert!(
+        !diagnostics.has_errors(),
+        "{}:\n{}",
+        path.display(),
+        diagnostics.render()
+    );
+    (bus, configured)
+}
+
 /// The target directory cargo uses for this workspace.
 pub fn target_dir() -> PathBuf {
     match std::env::var_os("CARGO_TARGET_DIR") {

@@ -236,14 +236,7 @@ fn a_mandatory_slave_booting_after_the_boot_time_fails_the_network_then_boots() 
         }
     });
     assert!(booted, "{:#?}", rig.events);
-    let status = rig
-        .master
-        .core()
-        .network()
-        .unwrap()
-        .slave(id(LEFT))
-        .unwrap()
-        .clone();
+    let status = rig.slave(LEFT);
     assert_eq!(status.state, SlaveState::Booted, "{status:#?}");
     assert_eq!(status.error, None);
 }

@@ -77,13 +77,9 @@ fn every_fixture_reports_its_rule() {
 
 #[test]
 fn the_corpus_networks_check_without_errors() {
-    let Some(shared) = eds2rust_tests::shared_dir() else {
-        eds2rust_tests::not_run(
-            "network check of the corpus: ../shared is not beside this checkout",
-        );
+    let Some(dir) = eds2rust_tests::network_corpus("network check of the corpus") else {
         return;
     };
-    let dir = shared.join("network-corpus");
     let mut networks: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap_or_else(|e| panic!("cannot list {}: {e}", dir.display()))
         .map(|e| e.expect("entry").path())

@@ -134,11 +134,10 @@ fn compare(bus: &Bus, out: &Path) {
 
 #[test]
 fn trinamic_pd42_concise_dcf_equals_dcfgens() {
-    let Some(shared) = eds2rust_tests::shared_dir() else {
-        eds2rust_tests::not_run("network_configure: ../shared/network-corpus");
+    let Some(corpus) = eds2rust_tests::network_corpus("network_configure") else {
         return;
     };
-    let dir = shared.join("network-corpus/trinamic_pd42");
+    let dir = corpus.join("trinamic_pd42");
     let mut s = slave("trinamic_pd42", &dir, "TMCM-1270.eds", 1);
     s.heartbeat_producer = Some(at(1000));
     s.sdo = vec![
@@ -158,11 +157,10 @@ fn trinamic_pd42_concise_dcf_equals_dcfgens() {
 
 #[test]
 fn prbt_pilz6_concise_dcf_equals_dcfgens() {
-    let Some(shared) = eds2rust_tests::shared_dir() else {
-        eds2rust_tests::not_run("network_configure: ../shared/network-corpus");
+    let Some(corpus) = eds2rust_tests::network_corpus("network_configure") else {
         return;
     };
-    let dir = shared.join("network-corpus/prbt_pilz6");
+    let dir = corpus.join("prbt_pilz6");
     let slaves = (1..=6)
         .map(|j| {
             let mut s = slave(&format!("prbt_joint_{j}"), &dir, "prbt_0_1.dcf", j + 2);
@@ -207,12 +205,11 @@ fn prbt_pilz6_concise_dcf_equals_dcfgens() {
 /// the concise DCFs equal dcfgen's.
 #[test]
 fn corpus_read_from_bus_files_equals_dcfgens() {
-    let Some(shared) = eds2rust_tests::shared_dir() else {
-        eds2rust_tests::not_run("network_configure (read): ../shared/network-corpus");
+    let Some(corpus) = eds2rust_tests::network_corpus("network_configure (read)") else {
         return;
     };
     for network in ["trinamic_pd42", "prbt_pilz6"] {
-        let dir = shared.join("network-corpus").join(network);
+        let dir = corpus.join(network);
         for file in ["bus.yml", "bus.expanded.yml"] {
             let loaded = eds2rust::network::read_file(&dir.join(file), &Options::lenient());
             assert!(

@@ -12,13 +12,8 @@ use eds2rust::read::Options;
 
 /// `../shared/network-corpus/<name>`, or `None` after one visible line.
 fn network(name: &str) -> Option<PathBuf> {
-    let Some(shared) = eds2rust_tests::shared_dir() else {
-        eds2rust_tests::not_run(&format!(
-            "network corpus read test ({name}): ../shared/network-corpus is not beside this checkout"
-        ));
-        return None;
-    };
-    Some(shared.join("network-corpus").join(name))
+    let corpus = eds2rust_tests::network_corpus(&format!("network corpus read test ({name})"))?;
+    Some(corpus.join(name))
 }
 
 fn read(path: &Path) -> (Bus, BusLoaded) {

@@ -198,21 +198,7 @@ fn compare(written: &Written, theirs_dir: &Path) -> Tally {
 
 /// `net dcf -r` through the library, as the CLI runs it.
 fn ours(bus_file: &Path) -> Written {
-    let loaded = eds2rust::network::read_file(bus_file, &eds2rust::read::Options::default());
-    assert!(
-        !loaded.diagnostics.has_errors(),
-        "{}:\n{}",
-        bus_file.display(),
-        loaded.diagnostics.render()
-    );
-    let bus = loaded.bus.expect("a bus");
-    let (configured, diagnostics) = eds2rust::network::configure(&bus);
-    assert!(
-        !diagnostics.has_errors(),
-        "{}:\n{}",
-        bus_file.display(),
-        diagnostics.render()
-    );
+    let (bus, configured) = eds2rust_tests::configured_network(bus_file);
     dcf::files(&bus, &configured, true)
 }
 

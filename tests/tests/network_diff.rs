@@ -67,14 +67,11 @@ fn a_network_against_itself_has_no_changes() {
 /// changes; their API listings list every node and its PDOs.
 #[test]
 fn corpus_networks_against_themselves() {
-    let Some(shared) = eds2rust_tests::shared_dir() else {
-        eds2rust_tests::not_run(
-            "network diff of the corpus networks: ../shared/network-corpus is not beside this checkout",
-        );
+    let Some(corpus) = eds2rust_tests::network_corpus("network diff of the corpus networks") else {
         return;
     };
     for name in ["prbt_pilz6", "trinamic_pd42"] {
-        let path = shared.join("network-corpus").join(name).join("bus.yml");
+        let path = corpus.join(name).join("bus.yml");
         let n = load_path(&path, name, true);
         assert_eq!(changes(&n, &n), Vec::new(), "{name}");
         let listing = eds2rust::network::api::api_listing(&n.0, &n.1, &Default::default())

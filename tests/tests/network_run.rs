@@ -39,16 +39,7 @@ fn a_slave_that_resets_during_operation_is_booted_again_while_the_other_runs() {
     );
     assert_eq!(rig.downloads(RIGHT).len(), 2 * n);
     assert_eq!(rig.sim().get_uint(id(RIGHT), 0x6060, 0), Some(8));
-    assert_eq!(
-        rig.master
-            .core()
-            .network()
-            .unwrap()
-            .slave(id(RIGHT))
-            .unwrap()
-            .boots,
-        2
-    );
+    assert_eq!(rig.slave(RIGHT).boots, 2);
     // The other slave ran on: its TPDO came every SYNC meanwhile.
     let pdos: Vec<Instant> = rig.frames(0x182).iter().map(|(t, _)| *t).collect();
     let from = Instant::ZERO + at - Duration::from_millis(100);
@@ -82,14 +73,7 @@ fn a_lost_heartbeat_is_status_e_and_its_return_boots_the_slave_again() {
         }
     });
     assert!(booted_again, "{:#?}", rig.events);
-    let status = rig
-        .master
-        .core()
-        .network()
-        .unwrap()
-        .slave(id(RIGHT))
-        .unwrap()
-        .clone();
+    let status = rig.slave(RIGHT);
     assert_eq!(status.state, SlaveState::Operational, "{status:#?}");
     assert_eq!(status.boots, 2);
     // `left` was never lost.
@@ -192,14 +176,7 @@ fn a_guarded_slave_that_stops_answering_is_status_f_and_booted_again() {
     });
     let rebooting = rig.position("Rebooting", |e| *e == NetworkEvent::Rebooting(id(RIGHT)));
     assert!(lost < rebooting, "{:#?}", rig.events);
-    let status = rig
-        .master
-        .core()
-        .network()
-        .unwrap()
-        .slave(id(RIGHT))
-        .unwrap()
-        .clone();
+    let status = rig.slave(RIGHT);
     assert_eq!(status.state, SlaveState::Operational, "{status:#?}");
     assert_eq!(status.boots, 2);
 }
@@ -313,13 +290,9 @@ fn every_network_of_the_repository_boots_against_its_own_simulation() {
 
 #[test]
 fn the_network_corpus_boots_against_its_own_simulation() {
-    let Some(shared) = eds2rust_tests::shared_dir() else {
-        eds2rust_tests::not_run(
-            "network corpus boot test: ../shared/network-corpus is not beside this checkout",
-        );
+    let Some(corpus) = eds2rust_tests::network_corpus("network corpus boot test") else {
         return;
     };
-    let corpus = shared.join("network-corpus");
     // Six Pilz PRBT joints in interpolated position mode (declared by their
     // 0x6502, taken by the generic drive), one Trinamic PD42.
     boots_as_its_files_say(&corpus.join("prbt_pilz6/bus.yml"), true, &[]);

@@ -27,8 +27,7 @@ use std::sync::mpsc::{Receiver, RecvTimeoutError, channel};
 use std::time::{Duration, Instant};
 
 use eds2rust::network::configured::configured_device;
-use eds2rust::network::{boot_plan, config::Configured, configure, model::Bus, read_file};
-use eds2rust::read::Options;
+use eds2rust::network::{boot_plan, config::Configured, model::Bus};
 use eds2rust_decode::pdo::Raw;
 use eds2rust_decode::{Decoder, Record};
 use eds2rust_runtime::blocking::Master;
@@ -58,16 +57,7 @@ struct Network {
 }
 
 fn read_network(path: &Path) -> Network {
-    let loaded = read_file(path, &Options::default());
-    assert!(
-        !loaded.diagnostics.has_errors(),
-        "{}:\n{}",
-        path.display(),
-        loaded.diagnostics.render()
-    );
-    let bus = loaded.bus.expect("a bus");
-    let (configured, diagnostics) = configure(&bus);
-    assert!(!diagnostics.has_errors(), "{}", diagnostics.render());
+    let (bus, configured) = eds2rust_tests::configured_network(path);
     Network { bus, configured }
 }
 

@@ -8,7 +8,7 @@ pub use std::time::Duration;
 pub use eds2rust_runtime::blocking;
 pub use eds2rust_runtime::boot::{
     BootError, BootEvent, BootStatus, Configuration, NetworkEvent, NetworkPlan, NetworkReport,
-    SlaveState, Supervision,
+    SlaveState, SlaveStatus, Supervision,
 };
 pub use eds2rust_runtime::master::{Master, MasterEvent};
 pub use eds2rust_runtime::od::NodeId;
@@ -92,6 +92,17 @@ impl Rig {
                 self.events.push(e);
             }
         }
+    }
+
+    /// The master's status of slave `node` now.
+    pub fn slave(&self, node: u8) -> SlaveStatus {
+        self.master
+            .core()
+            .network()
+            .expect("a network")
+            .slave(id(node))
+            .expect("a slave of the network")
+            .clone()
     }
 
     pub fn now(&self) -> Instant {
