@@ -308,37 +308,18 @@ fn python_heartbeat_reaches_our_consumer() {
     let mut consumer = HeartbeatConsumer::new();
     consumer.monitor(n, Some(Duration::from_millis(150)));
 
-    ok(
-        py,
-        json!({"op": "local_nmt", "node": ID, "state": "INITIALISING"}),
-    );
-    wait_event(py, &mut port, &clock, &mut consumer, |e| {
-        *e == HeartbeatEvent::State {
-            node: n,
-            state: NmtState::BootUp,
-        }
-    });
-    // Boot complete: python starts its heartbeat (0x1017 = 20 ms).
-    ok(
-        py,
-        json!({"op": "local_nmt", "node": ID, "state": "PRE-OPERATIONAL"}),
-    );
-    wait_event(py, &mut port, &clock, &mut consumer, |e| {
-        *e == HeartbeatEvent::State {
-            node: n,
-            state: NmtState::PreOperational,
-        }
-    });
-    ok(
-        py,
-        json!({"op": "local_nmt", "node": ID, "state": "OPERATIONAL"}),
-    );
-    wait_event(py, &mut port, &clock, &mut consumer, |e| {
-        *e == HeartbeatEvent::State {
-            node: n,
-            state: NmtState::Operational,
-        }
-    });
+    // Boot-up, then boot complete: python starts its heartbeat (0x1017 =
+    // 20 ms) in pre-operational, then operational.
+    for (python, state) in [
+        ("INITIALISING", NmtState::BootUp),
+        ("PRE-OPERATIONAL", NmtState::PreOperational),
+        ("OPERATIONAL", NmtState::Operational),
+    ] {
+        ok(py, json!({"op": "local_nmt", "node": ID, "state": python}));
+        wait_event(py, &mut port, &clock, &mut consumer, |e| {
+            *e == HeartbeatEvent::State { node: n, state }
+        });
+    }
     assert_eq!(consumer.state(n), Some(NmtState::Operational));
     assert!(!consumer.is_timed_out(n));
 

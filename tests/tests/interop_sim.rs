@@ -216,91 +216,112 @@ fn node(id: u8) -> NodeId {
     NodeId::new(id).expect("node id")
 }
 
+/// python-canopen with a `RemoteNode` of the seed device `name` at `id`
+/// (its exported EDS) against our simulator from `make`: the peer, the
+/// running simulator and the TPDO maps python-canopen read.
+fn seed_node<B>(
+    name: &str,
+    id: u8,
+    make: impl FnOnce(Instant) -> Device<B>,
+) -> (PyPeer, Running, BTreeMap<u64, PyMap>)
+where
+    B: Behaviour + Send + 'static,
+    B::Event: Send,
+{
+    let py = PyPeer::spawn().unwrap_or_else(|e| panic!("{e}"));
+    let eds = export_eds(name);
+    let sim = Running::start(&py, make);
+    start_node(&py, id, &eds);
+    let maps = read_maps(&py, id);
+    (py, sim, maps)
+}
+
+/// A received TPDO (its bytes and python-canopen's values) decodes to the
+/// same values with our struct (`ours`).
+fn assert_decodes_alike(
+    (data, values): &(Vec<u8>, Vec<i128>),
+    ours: impl FnOnce(&[u8]) -> Vec<i128>,
+) {
+    assert_eq!(values, &ours(data), "data {data:02X?}");
+}
+
 #[test]
 fn linak_tpdo_feedback_reads_and_decodes_alike() {
     use linak_techline::pdo::Tpdo1Feedback;
-    let py = PyPeer::spawn().unwrap_or_else(|e| panic!("{e}"));
-    let eds = export_eds("linak_techline");
-    let _sim = Running::start(&py, models::linak_techline::simulator);
     let id = linak_techline::DEFAULT_NODE_ID;
-    start_node(&py, id, &eds);
-    let maps = read_maps(&py, id);
+    let (py, _sim, maps) = seed_node("linak_techline", id, models::linak_techline::simulator);
     check_map::<Tpdo1Feedback>(&maps, 1, node(id));
     let received = start_and_receive(&py, id, &[1], maps[&1].trans_type <= 240);
-    let (data, values) = &received[0];
-    let p = Tpdo1Feedback::decode(data).expect("8 bytes");
-    let ours = [
-        i128::from(p.position.0),
-        i128::from(p.current.0),
-        i128::from(p.status_flags.0),
-        i128::from(p.error_code.0),
-        i128::from(p.speed.0),
-        i128::from(p.aux_inputs.0),
-    ];
-    assert_eq!(values, &ours, "data {data:02X?}");
+    assert_decodes_alike(&received[0], |data| {
+        let p = Tpdo1Feedback::decode(data).expect("8 bytes");
+        vec![
+            i128::from(p.position.0),
+            i128::from(p.current.0),
+            i128::from(p.status_flags.0),
+            i128::from(p.error_code.0),
+            i128::from(p.speed.0),
+            i128::from(p.aux_inputs.0),
+        ]
+    });
 }
 
 #[test]
 fn zimmer_tpdos_read_and_decode_alike() {
     use zimmer_acs::pdo::{Tpdo1StatusAndPosition, Tpdo2Velocity, Tpdo3FollowingErrorAndTorque};
-    let py = PyPeer::spawn().unwrap_or_else(|e| panic!("{e}"));
-    let eds = export_eds("zimmer_acs");
-    let _sim = Running::start(&py, models::zimmer_acs::simulator);
     let id = zimmer_acs::DEFAULT_NODE_ID;
-    start_node(&py, id, &eds);
-    let maps = read_maps(&py, id);
+    let (py, _sim, maps) = seed_node("zimmer_acs", id, models::zimmer_acs::simulator);
     check_map::<Tpdo1StatusAndPosition>(&maps, 1, node(id));
     check_map::<Tpdo2Velocity>(&maps, 2, node(id));
     check_map::<Tpdo3FollowingErrorAndTorque>(&maps, 3, node(id));
     let synchronous = maps[&1].trans_type <= 240 || maps[&3].trans_type <= 240;
     let received = start_and_receive(&py, id, &[1, 3], synchronous);
-    let (data, values) = &received[0];
-    let p = Tpdo1StatusAndPosition::decode(data).expect("6 bytes");
-    let ours = [
-        i128::from(p.statusword.0),
-        i128::from(p.position_actual_value.0),
-    ];
-    assert_eq!(values, &ours, "data {data:02X?}");
-    let (data, values) = &received[1];
-    let p = Tpdo3FollowingErrorAndTorque::decode(data).expect("TPDO3 length");
-    let ours = [
-        i128::from(p.following_error_actual_value.0),
-        i128::from(p.torque_actual_value.0),
-    ];
-    assert_eq!(values, &ours, "data {data:02X?}");
+    assert_decodes_alike(&received[0], |data| {
+        let p = Tpdo1StatusAndPosition::decode(data).expect("6 bytes");
+        vec![
+            i128::from(p.statusword.0),
+            i128::from(p.position_actual_value.0),
+        ]
+    });
+    assert_decodes_alike(&received[1], |data| {
+        let p = Tpdo3FollowingErrorAndTorque::decode(data).expect("TPDO3 length");
+        vec![
+            i128::from(p.following_error_actual_value.0),
+            i128::from(p.torque_actual_value.0),
+        ]
+    });
 }
 
 #[test]
 fn interroll_tpdos_read_and_decode_alike() {
     use interroll_ec5000bi::pdo::{Tpdo1Status, Tpdo2Position, Tpdo3Velocity};
-    let py = PyPeer::spawn().unwrap_or_else(|e| panic!("{e}"));
-    let eds = export_eds("interroll_ec5000bi");
-    let _sim = Running::start(&py, models::interroll_ec5000bi::simulator);
     let id = interroll_ec5000bi::DEFAULT_NODE_ID;
-    start_node(&py, id, &eds);
-    let maps = read_maps(&py, id);
+    let (py, _sim, maps) = seed_node(
+        "interroll_ec5000bi",
+        id,
+        models::interroll_ec5000bi::simulator,
+    );
     check_map::<Tpdo1Status>(&maps, 1, node(id));
     check_map::<Tpdo2Position>(&maps, 2, node(id));
     check_map::<Tpdo3Velocity>(&maps, 3, node(id));
     let synchronous = maps[&1].trans_type <= 240 || maps[&2].trans_type <= 240;
     let received = start_and_receive(&py, id, &[1, 2], synchronous);
-    let (data, values) = &received[0];
-    let p = Tpdo1Status::decode(data).expect("TPDO1 length");
-    let ours = [
-        i128::from(p.statusword.0),
-        i128::from(p.modes_of_operation_display.0),
-        i128::from(p.error_register.0),
-        i128::from(p.actual_temperature.0),
-        i128::from(p.torque_actual_value.0),
-    ];
-    assert_eq!(values, &ours, "data {data:02X?}");
-    let (data, values) = &received[1];
-    let p = Tpdo2Position::decode(data).expect("TPDO2 length");
-    let ours = [
-        i128::from(p.statusword.0),
-        i128::from(p.position_actual_value.0),
-    ];
-    assert_eq!(values, &ours, "data {data:02X?}");
+    assert_decodes_alike(&received[0], |data| {
+        let p = Tpdo1Status::decode(data).expect("TPDO1 length");
+        vec![
+            i128::from(p.statusword.0),
+            i128::from(p.modes_of_operation_display.0),
+            i128::from(p.error_register.0),
+            i128::from(p.actual_temperature.0),
+            i128::from(p.torque_actual_value.0),
+        ]
+    });
+    assert_decodes_alike(&received[1], |data| {
+        let p = Tpdo2Position::decode(data).expect("TPDO2 length");
+        vec![
+            i128::from(p.statusword.0),
+            i128::from(p.position_actual_value.0),
+        ]
+    });
 }
 
 /// A custom TPDO and RPDO declared with `#[derive(Pdo)]` for the Interroll
