@@ -15,6 +15,10 @@ mod live;
 mod monitor;
 mod net;
 mod refusal;
+// The unit tests' simulated devices, shared with the vcan tests.
+#[cfg(test)]
+#[path = "../tests/support/served.rs"]
+mod served;
 mod sim;
 
 use std::io::Write;

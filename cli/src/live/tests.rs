@@ -5,19 +5,14 @@
 use std::path::PathBuf;
 use std::time::Duration;
 
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
-
-use eds2rust_runtime::Service;
-use eds2rust_runtime::blocking;
 use eds2rust_runtime::lss::Identity;
 use eds2rust_runtime::transport::virtual_bus::VirtualBus;
-use eds2rust_runtime::transport::{Bus, Clock};
 use eds2rust_sim::models::{interroll_ec5000bi, linak_techline, zimmer_acs};
 use eds2rust_sim::{Behaviour, Device, DeviceConfig};
 
 use super::bus::LiveBus;
 use super::*;
+use crate::served::Served;
 
 fn eds(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
@@ -36,8 +31,7 @@ fn bus_args(timeout_ms: u64) -> BusArgs {
 /// port of that bus, so that several commands talk to one device.
 struct Sim {
     bus: VirtualBus,
-    stop: Arc<AtomicBool>,
-    thread: Option<std::thread::JoinHandle<()>>,
+    _served: Served,
 }
 
 impl Sim {
@@ -47,35 +41,15 @@ impl Sim {
         B::Event: Send,
     {
         let bus = VirtualBus::new();
-        let clock = Clock::new();
-        let mut port = bus.attach();
-        let mut device = device(clock.now());
-        while let Some(frame) = device.poll_transmit() {
-            port.send(&frame).unwrap();
-        }
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&stop);
-        let thread = std::thread::spawn(move || {
-            blocking::serve(&mut port, &clock, &mut device, &flag, None, |_| {}).unwrap();
-        });
+        let served = Served::start(bus.attach(), device);
         Sim {
             bus,
-            stop,
-            thread: Some(thread),
+            _served: served,
         }
     }
 
     fn bus(&self) -> LiveBus {
         LiveBus::new(Box::new(self.bus.attach()))
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.thread.take() {
-            let _ = t.join();
-        }
     }
 }
 

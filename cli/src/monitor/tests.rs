@@ -9,13 +9,14 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
+use eds2rust_runtime::transport::Bus;
 use eds2rust_runtime::transport::virtual_bus::VirtualBus;
-use eds2rust_runtime::transport::{Bus, Clock};
-use eds2rust_runtime::{CanId, Frame, Service, blocking};
+use eds2rust_runtime::{CanId, Frame};
 use eds2rust_sim::models::linak_techline;
 
 use super::plot::parse_spec;
 use super::*;
+use crate::served::Served;
 
 const LINAK: u8 = 32;
 
@@ -410,17 +411,7 @@ fn on_a_terminal_the_table_is_redrawn_in_place() {
 #[test]
 fn the_loop_on_the_virtual_bus_against_the_linak_simulator() {
     let bus = VirtualBus::new();
-    let clock = Clock::new();
-    let mut port = bus.attach();
-    let mut device = linak_techline::simulator(clock.now());
-    while let Some(f) = device.poll_transmit() {
-        port.send(&f).unwrap();
-    }
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
-    let sim = std::thread::spawn(move || {
-        blocking::serve(&mut port, &clock, &mut device, &flag, None, |_| {}).unwrap();
-    });
+    let sim = Served::start(bus.attach(), linak_techline::simulator);
     let mut monitor_port = bus.attach();
     let mut master = bus.attach();
     master
@@ -438,8 +429,7 @@ fn the_loop_on_the_virtual_bus_against_the_linak_simulator() {
         &mut out,
     )
     .unwrap();
-    stop.store(true, Ordering::Relaxed);
-    sim.join().unwrap();
+    drop(sim);
 
     let out = String::from_utf8(out).unwrap();
     eprintln!("{out}");

@@ -5,20 +5,21 @@
 
 #![allow(dead_code)]
 
+#[path = "../support/served.rs"]
+mod served;
+
 use std::io::{BufRead, BufReader, Read};
 use std::path::PathBuf;
 use std::process::{Child, Command, Output, Stdio};
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::mpsc;
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use eds2rust_runtime::blocking;
+use eds2rust_runtime::Instant;
 use eds2rust_runtime::transport::socketcan::SocketCanBus;
-use eds2rust_runtime::transport::{Bus, Clock};
-use eds2rust_runtime::{Instant, Service};
 use eds2rust_sim::{Behaviour, Device};
+
+use served::Served;
 
 pub fn iface(index: usize) -> String {
     let list = std::env::var("CAN_IFACES").unwrap_or_else(|_| {
@@ -215,10 +216,7 @@ impl Drop for Running {
 }
 
 /// A simulated device on a SocketCAN interface, in a thread.
-pub struct Sim {
-    stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<std::io::Result<()>>>,
-}
+pub struct Sim(Served);
 
 impl Sim {
     pub fn start<B>(name: &str, device: impl FnOnce(Instant) -> Device<B>) -> Sim
@@ -226,32 +224,7 @@ impl Sim {
         B: Behaviour + Send + 'static,
         B::Event: Send,
     {
-        let mut port = SocketCanBus::open(name).unwrap_or_else(|e| panic!("opening {name}: {e}"));
-        let clock = Clock::new();
-        let mut device = device(clock.now());
-        while let Some(frame) = device.poll_transmit() {
-            port.send(&frame).unwrap();
-        }
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&stop);
-        let thread = std::thread::spawn(move || {
-            blocking::serve(&mut port, &clock, &mut device, &flag, None, |_| {})
-        });
-        Sim {
-            stop,
-            thread: Some(thread),
-        }
-    }
-}
-
-impl Drop for Sim {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(t) = self.thread.take() {
-            let r = t.join().expect("the simulator thread panicked");
-            if !std::thread::panicking() {
-                r.expect("the simulator's bus failed");
-            }
-        }
+        let port = SocketCanBus::open(name).unwrap_or_else(|e| panic!("opening {name}: {e}"));
+        Sim(Served::start(port, device))
     }
 }
