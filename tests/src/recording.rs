@@ -37,20 +37,16 @@
 //! torque) and, on a badly stalled machine, an extra heartbeat.
 
 use std::io;
-use std::path::PathBuf;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Condvar, Mutex, MutexGuard};
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant as StdInstant};
 
-use eds2rust::eds::Options;
-use eds2rust::r#gen::eds::to_eds;
 use eds2rust_runtime::trace::candump::{Format, Writer};
-use eds2rust_runtime::transport::{Bus, Clock};
-use eds2rust_runtime::{Frame, Instant, Service, blocking};
+use eds2rust_runtime::transport::Bus;
+use eds2rust_runtime::{Frame, Instant, Service};
 use serde_json::{Value, json};
 
 use crate::peer::{PeerPort, PyPeer, hex, unhex};
+use crate::seed_sim::{Served, export_eds};
 
 /// The seed device the session simulates.
 pub const DEVICE: &str = "interroll_ec5000bi";
@@ -207,49 +203,6 @@ impl Bus for Recorder {
     }
 }
 
-/// The simulator's thread; dropping it stops the simulator.
-struct Simulator {
-    stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<io::Result<()>>>,
-}
-
-impl Simulator {
-    fn start<S>(mut bus: Recorder, simulator: impl FnOnce(Instant) -> S) -> Simulator
-    where
-        S: Service + Send + 'static,
-    {
-        let clock = Clock::new();
-        let mut device = simulator(clock.now());
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&stop);
-        let thread = std::thread::spawn(move || {
-            blocking::serve(&mut bus, &clock, &mut device, &flag, None, |_| {})
-        });
-        Simulator {
-            stop,
-            thread: Some(thread),
-        }
-    }
-
-    fn finish(mut self) -> Result<(), String> {
-        self.stop.store(true, Ordering::Relaxed);
-        match self.thread.take().map(JoinHandle::join) {
-            Some(Ok(Ok(()))) | None => Ok(()),
-            Some(Ok(Err(e))) => Err(format!("the simulator's bus failed: {e}")),
-            Some(Err(_)) => Err("the simulator thread panicked".to_string()),
-        }
-    }
-}
-
-impl Drop for Simulator {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(thread) = self.thread.take() {
-            let _ = thread.join();
-        }
-    }
-}
-
 /// The session with the Interroll EC5000 BI simulator; `simulator` is
 /// `eds2rust_sim::models::interroll_ec5000bi::simulator` (eds2rust-sim is
 /// a dev-dependency of this crate, so the caller passes it in).
@@ -257,7 +210,7 @@ pub fn python_session_with<S>(simulator: impl FnOnce(Instant) -> S) -> Result<Se
 where
     S: Service + Send + 'static,
 {
-    let (eds, node) = export_eds(DEVICE)?;
+    let (eds, node) = export_eds(DEVICE, "recording")?;
     let py = PyPeer::spawn()?;
     let tap = Arc::new(Tap {
         start: StdInstant::now(),
@@ -272,7 +225,7 @@ where
     run.ok(json!({"op": "remote_node_eds", "node": node, "eds": eds}))?;
     run.ok(json!({"op": "sdo_log_start", "node": node}))?;
     run.ok(json!({"op": "local_node", "node": LOCAL_NODE}))?;
-    let sim = Simulator::start(
+    let sim = Served::start(
         Recorder {
             port: py.port(),
             tap: Arc::clone(&tap),
@@ -285,32 +238,6 @@ where
     stopped?;
     session.trace = trace(&tap.lock())?;
     Ok(session)
-}
-
-/// The seed table exported to EDS (for python-canopen's `RemoteNode`) and
-/// its node id.
-fn export_eds(name: &str) -> Result<(PathBuf, u8), String> {
-    let table = crate::workspace_root().join(format!("eds/{name}.yaml"));
-    let loaded = eds2rust::input::read_device(&table, &Options::strict());
-    if !loaded.diagnostics.is_empty() {
-        return Err(loaded.diagnostics.render());
-    }
-    let device = loaded
-        .device
-        .ok_or_else(|| format!("{} does not load", table.display()))?;
-    let node = device
-        .network
-        .node_id
-        .ok_or_else(|| format!("{} has no node id", table.display()))?;
-    let dir = crate::target_dir().join("tmp").join("recording");
-    std::fs::create_dir_all(&dir).map_err(|e| format!("cannot create {}: {e}", dir.display()))?;
-    let path = dir.join(format!("{name}.eds"));
-    // Written beside and renamed: parallel sessions never read half a file.
-    let part = dir.join(format!("{name}.eds.{}", std::process::id()));
-    std::fs::write(&part, to_eds(&device))
-        .and_then(|()| std::fs::rename(&part, &path))
-        .map_err(|e| format!("cannot write {}: {e}", path.display()))?;
-    Ok((path, node))
 }
 
 /// The candump `-l` log of `frames`.

@@ -10,11 +10,8 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::thread::JoinHandle;
 use std::time::{Duration, Instant as StdInstant};
 
-use eds2rust::eds::Options;
-use eds2rust::r#gen::eds::to_eds;
 use eds2rust_drivers::{interroll_ec5000bi, linak_techline, zimmer_acs};
 use eds2rust_runtime::od::standard::EventTimer;
 use eds2rust_runtime::od::{NodeId, Pdo};
@@ -24,63 +21,14 @@ use eds2rust_runtime::{Instant, blocking};
 use eds2rust_sim::models;
 use eds2rust_sim::{Behaviour, Device};
 use eds2rust_tests::peer::PyPeer;
+use eds2rust_tests::seed_sim::{self, Served};
 use serde_json::{Value, json};
 
 /// The EDS of a seed device, exported from its YAML table.
 fn export_eds(name: &str) -> PathBuf {
-    let root = eds2rust_tests::workspace_root();
-    let loaded =
-        eds2rust::input::read_device(&root.join(format!("eds/{name}.yaml")), &Options::strict());
-    assert!(
-        loaded.diagnostics.is_empty(),
-        "{}",
-        loaded.diagnostics.render()
-    );
-    let device = loaded.device.expect("the seed table loads");
-    let dir = root.join("target/tmp/interop_sim");
-    std::fs::create_dir_all(&dir).expect("create target/tmp/interop_sim");
-    let path = dir.join(format!("{name}.eds"));
-    std::fs::write(&path, to_eds(&device)).expect("write the EDS");
-    path
-}
-
-/// A simulator serving python-canopen's bus in a thread.
-struct Running {
-    stop: Arc<AtomicBool>,
-    thread: Option<JoinHandle<std::io::Result<()>>>,
-}
-
-impl Running {
-    fn start<B>(py: &PyPeer, make: impl FnOnce(Instant) -> Device<B>) -> Running
-    where
-        B: Behaviour + Send + 'static,
-        B::Event: Send,
-    {
-        let clock = Clock::new();
-        let mut device = make(clock.now());
-        let mut port = py.port();
-        let stop = Arc::new(AtomicBool::new(false));
-        let flag = Arc::clone(&stop);
-        let thread = std::thread::spawn(move || {
-            blocking::serve(&mut port, &clock, &mut device, &flag, None, |_| {})
-        });
-        Running {
-            stop,
-            thread: Some(thread),
-        }
-    }
-}
-
-impl Drop for Running {
-    fn drop(&mut self) {
-        self.stop.store(true, Ordering::Relaxed);
-        if let Some(thread) = self.thread.take() {
-            let result = thread.join().expect("the simulator thread panicked");
-            if !std::thread::panicking() {
-                result.expect("the simulator's bus failed");
-            }
-        }
-    }
+    seed_sim::export_eds(name, "interop_sim")
+        .unwrap_or_else(|e| panic!("{e}"))
+        .0
 }
 
 /// What python-canopen read of one TPDO.
@@ -223,14 +171,14 @@ fn seed_node<B>(
     name: &str,
     id: u8,
     make: impl FnOnce(Instant) -> Device<B>,
-) -> (PyPeer, Running, BTreeMap<u64, PyMap>)
+) -> (PyPeer, Served, BTreeMap<u64, PyMap>)
 where
     B: Behaviour + Send + 'static,
     B::Event: Send,
 {
     let py = PyPeer::spawn().unwrap_or_else(|e| panic!("{e}"));
     let eds = export_eds(name);
-    let sim = Running::start(&py, make);
+    let sim = Served::start(py.port(), make);
     start_node(&py, id, &eds);
     let maps = read_maps(&py, id);
     (py, sim, maps)
