@@ -4,6 +4,7 @@
 //! (tests/sim_vcan.rs does the same over kernel vcan with python-canopen.)
 
 use std::path::{Path, PathBuf};
+use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::thread::JoinHandle;
@@ -34,8 +35,8 @@ fn args(file: PathBuf, node: u8) -> SimArgs {
 }
 
 /// A simulation in a thread; its event lines and status lines at the end.
-struct Running {
-    bus: VirtualBus,
+pub(in crate::sim) struct Running {
+    pub(in crate::sim) bus: VirtualBus,
     stop: Arc<AtomicBool>,
     thread: Option<JoinHandle<(String, String, String)>>,
 }
@@ -48,21 +49,25 @@ impl Running {
         )
         .expect("the file reads");
         let node = NodeId::new(args.node.unwrap()).unwrap();
+        Running::spawn(move |port, stop, out, err| {
+            simulate(&args, &table, node, port, stop, out, err)
+        })
+    }
+
+    /// `simulate` (a device or a network) on a port of a new virtual bus,
+    /// in a thread, until stopped.
+    pub(in crate::sim) fn spawn(
+        simulate: impl FnOnce(Box<dyn Bus + Send>, &AtomicBool, &mut Vec<u8>, &mut Vec<u8>) -> ExitCode
+        + Send
+        + 'static,
+    ) -> Running {
         let bus = VirtualBus::new();
         let port = bus.attach();
         let stop = Arc::new(AtomicBool::new(false));
         let flag = Arc::clone(&stop);
         let thread = std::thread::spawn(move || {
             let (mut out, mut err) = (Vec::new(), Vec::new());
-            let code = simulate(
-                &args,
-                &table,
-                node,
-                Box::new(port),
-                &flag,
-                &mut out,
-                &mut err,
-            );
+            let code = simulate(Box::new(port), &flag, &mut out, &mut err);
             (
                 format!("{code:?}"),
                 String::from_utf8(out).unwrap(),
@@ -83,7 +88,7 @@ impl Running {
     }
 
     /// Stops it: (exit status, stdout, stderr).
-    fn stop(mut self) -> (String, String, String) {
+    pub(in crate::sim) fn stop(mut self) -> (String, String, String) {
         self.stop.store(true, Ordering::Relaxed);
         self.thread.take().unwrap().join().unwrap()
     }

@@ -3,18 +3,16 @@
 //! slave), and the event lines name each node.
 
 use std::path::PathBuf;
-use std::sync::Arc;
-use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use eds2rust_runtime::blocking::Master;
 use eds2rust_runtime::boot::SlaveState;
 use eds2rust_runtime::master;
-use eds2rust_runtime::transport::virtual_bus::VirtualBus;
 use eds2rust_sim::network::Network;
 
 use super::{faults, simulate};
 use crate::sim::SimArgs;
+use crate::sim::tests::Running;
 
 fn args(faults: &[&str]) -> SimArgs {
     SimArgs {
@@ -39,30 +37,12 @@ fn a_master_boots_the_simulated_network_and_the_lines_name_the_nodes() {
     let args = args(&["right:missing", "2:sdo-abort=0x2000:0"]);
     let network = Network::load(bus_file()).unwrap();
     let faults = faults(&args, &network).unwrap();
-    let bus = VirtualBus::new();
-    let port = bus.attach();
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
     let sim_network = network.clone();
-    let thread = std::thread::spawn(move || {
-        let (mut out, mut err) = (Vec::new(), Vec::new());
-        let code = simulate(
-            &args,
-            &sim_network,
-            &faults,
-            Box::new(port),
-            &flag,
-            &mut out,
-            &mut err,
-        );
-        (
-            format!("{code:?}"),
-            String::from_utf8(out).unwrap(),
-            String::from_utf8(err).unwrap(),
-        )
+    let running = Running::spawn(move |port, stop, out, err| {
+        simulate(&args, &sim_network, &faults, port, stop, out, err)
     });
     let core = master::Master::for_network(network.plan()).unwrap();
-    let mut m = Master::new(bus.attach(), core);
+    let mut m = Master::new(running.bus.attach(), core);
     m.start().unwrap();
     let report = m
         .boot_network(
@@ -70,8 +50,7 @@ fn a_master_boots_the_simulated_network_and_the_lines_name_the_nodes() {
             std::time::Instant::now() + Duration::from_secs(10),
         )
         .unwrap();
-    stop.store(true, Ordering::Relaxed);
-    let (code, out, err) = thread.join().unwrap();
+    let (code, out, err) = running.stop();
     assert!(report.booted, "{report:#?}\n{out}\n{err}");
     let states: Vec<SlaveState> = report.slaves.iter().map(|s| s.state).collect();
     assert_eq!(states, [SlaveState::Operational, SlaveState::Failed]);
