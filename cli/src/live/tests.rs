@@ -59,6 +59,36 @@ fn run(f: impl FnOnce(&mut Vec<u8>) -> Result<(), LiveError>) -> (String, Result
     (String::from_utf8(out).unwrap(), r)
 }
 
+/// A fresh scratch directory of this test process (`tag` tells the tests
+/// apart).
+fn scratch(tag: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("eds2rust-live-{tag}{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// `od upload` of the Zimmer drive at `node` into `dcf`, without DOMAINs.
+fn upload_args(bus: BusArgs, node: u8, dcf: &std::path::Path) -> backup::UploadArgs {
+    backup::UploadArgs {
+        bus,
+        node,
+        od: eds("zimmer_acs.yaml"),
+        output: Some(dcf.to_path_buf()),
+        domains: false,
+    }
+}
+
+/// `od download` of `dcf` to the node it names, not verbose.
+fn download_args(dry_run: bool, dcf: PathBuf) -> backup::DownloadArgs {
+    backup::DownloadArgs {
+        bus: bus_args(500),
+        node: None,
+        dry_run,
+        verbose: false,
+        dcf,
+    }
+}
+
 fn zimmer() -> Sim {
     Sim::start(zimmer_acs::simulator)
 }
@@ -289,17 +319,10 @@ fn nmt_and_scan() {
 
 #[test]
 fn od_upload_then_download_restores_a_changed_value() {
-    let dir = std::env::temp_dir().join(format!("eds2rust-live-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("");
     let dcf = dir.join("node40.dcf");
     let sim = zimmer();
-    let up = backup::UploadArgs {
-        bus: bus_args(500),
-        node: 40,
-        od: eds("zimmer_acs.yaml"),
-        output: Some(dcf.clone()),
-        domains: false,
-    };
+    let up = upload_args(bus_args(500), 40, &dcf);
     let (_, r) = run(|o| backup::upload(|| Ok(sim.bus()), &up, o));
     r.unwrap();
     let text = std::fs::read_to_string(&dcf).unwrap();
@@ -319,13 +342,7 @@ fn od_upload_then_download_restores_a_changed_value() {
     );
 
     // The plan: PDO disabled, mapping count 0, entries, count, COB-ID.
-    let down = backup::DownloadArgs {
-        bus: bus_args(500),
-        node: None,
-        dry_run: true,
-        verbose: false,
-        dcf: dcf.clone(),
-    };
+    let down = download_args(true, dcf.clone());
     let (plan, r) = run(|o| backup::download_plan(&down, o));
     r.unwrap();
     let at = |needle: &str| {
@@ -382,8 +399,7 @@ fn od_upload_then_download_restores_a_changed_value() {
 
 #[test]
 fn od_download_reports_refused_entries() {
-    let dir = std::env::temp_dir().join(format!("eds2rust-live-r{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("r");
     let dcf = dir.join("bad.dcf");
     // A DCF with a value for an object the simulated device does not have.
     let mut device = od::Od::load(&eds("zimmer_acs.yaml")).unwrap().device;
@@ -403,13 +419,7 @@ fn od_download_reports_refused_entries() {
     });
     std::fs::write(&dcf, eds2rust::r#gen::to_eds(&device)).unwrap();
     let sim = zimmer();
-    let down = backup::DownloadArgs {
-        bus: bus_args(500),
-        node: None,
-        dry_run: false,
-        verbose: false,
-        dcf,
-    };
+    let down = download_args(false, dcf);
     let (out, r) = run(|o| backup::download(|| Ok(sim.bus()), &down, o));
     let lines: Vec<&str> = out.lines().collect();
     assert_eq!(
@@ -483,8 +493,7 @@ fn lss_fastscan_and_set_node_id() {
     r.unwrap();
     assert_eq!(out, "0x1018.4 = 87 D6 12 00\n");
     // A file into a string entry by block transfer, read back.
-    let dir = std::env::temp_dir().join(format!("eds2rust-live-f{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("f");
     let file = dir.join("catalogue.txt");
     std::fs::write(&file, "CAT-0123456789-ABCDEFGHIJ").unwrap();
     let d = sdo::DownloadFileArgs {
@@ -514,17 +523,10 @@ fn lss_fastscan_and_set_node_id() {
 
 #[test]
 fn od_upload_of_a_silent_node_writes_no_dcf() {
-    let dir = std::env::temp_dir().join(format!("eds2rust-live-s{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = scratch("s");
     let dcf = dir.join("node41.dcf");
     let sim = zimmer();
-    let up = backup::UploadArgs {
-        bus: bus_args(50),
-        node: 41,
-        od: eds("zimmer_acs.yaml"),
-        output: Some(dcf.clone()),
-        domains: false,
-    };
+    let up = upload_args(bus_args(50), 41, &dcf);
     let (out, r) = run(|o| backup::upload(|| Ok(sim.bus()), &up, o));
     assert_eq!(out, "");
     let Err(LiveError::Failed(m)) = r else {
