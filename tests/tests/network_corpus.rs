@@ -35,10 +35,12 @@ fn without_spots(slave: &SlaveSection) -> String {
     let blank = Spot::default();
     s.spot = blank.clone();
     s.dcf.spot = blank.clone();
+    // Blanks the spot of each optional field `$f` of `$on` that is set.
     macro_rules! blank_opt {
-        ($($f:ident),*) => { $( if let Some(v) = &mut s.$f { v.spot = blank.clone(); } )* };
+        ($on:expr; $($f:ident),*) => { $( if let Some(v) = &mut $on.$f { v.spot = blank.clone(); } )* };
     }
     blank_opt!(
+        s;
         node_id,
         dcf_path,
         revision_number,
@@ -64,10 +66,8 @@ fn without_spots(slave: &SlaveSection) -> String {
     for pdo in s.rpdo.values_mut().chain(s.tpdo.values_mut()) {
         pdo.spot = blank.clone();
         pdo.enabled.spot = blank.clone();
-        macro_rules! blank_pdo {
-            ($($f:ident),*) => { $( if let Some(v) = &mut pdo.$f { v.spot = blank.clone(); } )* };
-        }
-        blank_pdo!(
+        blank_opt!(
+            pdo;
             cob_id,
             transmission,
             inhibit_time,
