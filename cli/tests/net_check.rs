@@ -26,24 +26,15 @@ fn net_check_exit_codes_and_levels() {
     let restricted = fixture("cob-id-restricted");
     assert_eq!(run(&["net", "check", &restricted]).0, 0);
     assert_eq!(run(&["net", "check", "--strict", &restricted]).0, 1);
-    let (code, stdout, _) = run(&[
-        "net",
-        "check",
-        "--deny",
-        "net::cob-id-restricted",
-        &restricted,
-    ]);
-    assert_eq!(code, 1, "{stdout}");
-    assert!(stdout.contains("is denied by --deny"), "{stdout}");
-    let (code, stdout, _) = run(&[
-        "net",
-        "check",
-        "--allow",
-        "net::cob-id-restricted",
-        &restricted,
-    ]);
-    assert_eq!(code, 0, "{stdout}");
-    assert!(stdout.contains("0 errors, 0 warnings"), "{stdout}");
+    for (level, status, says) in [
+        ("--deny", 1, "is denied by --deny"),
+        ("--allow", 0, "0 errors, 0 warnings"),
+    ] {
+        let rule = "net::cob-id-restricted";
+        let (code, stdout, _) = run(&["net", "check", level, rule, &restricted]);
+        assert_eq!(code, status, "{level}: {stdout}");
+        assert!(stdout.contains(says), "{level}: {stdout}");
+    }
 
     // The bus load limit.
     let load = fixture("bus-load");

@@ -3,7 +3,7 @@
 
 mod common;
 
-use common::{example, run, tempdir};
+use common::{example, run, temp_file, tempdir};
 
 fn bus(dir: &std::path::Path, slave: &str) -> String {
     let path = dir.join("bus.yml");
@@ -48,21 +48,12 @@ fn writes_master_dcf_and_the_concise_dcfs() {
 fn writes_nothing_on_an_error() {
     let dir = tempdir().join("net_dcf_bad");
     let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("bus.yml");
-    std::fs::write(
-        &path,
+    let path = temp_file(
+        "net_dcf_bad/bus.yml",
         "master:\n  node_id: 1\naxis:\n  dcf: missing.eds\n  node_id: 3\n",
-    )
-    .unwrap();
+    );
     let out = dir.join("out");
-    let (code, _, stderr) = run(&[
-        "net",
-        "dcf",
-        path.to_str().unwrap(),
-        "-o",
-        out.to_str().unwrap(),
-    ]);
+    let (code, _, stderr) = run(&["net", "dcf", &path, "-o", out.to_str().unwrap()]);
     assert_eq!(code, 1, "{stderr}");
     assert!(stderr.contains("not written: 1 errors"), "{stderr}");
     assert!(!out.exists());
