@@ -15,9 +15,11 @@ mod live;
 mod monitor;
 mod net;
 mod refusal;
-// The unit tests' simulated devices, shared with the vcan tests.
+// The unit tests' simulated devices: the rig of the tests crate (and of
+// the vcan tests), one file for both crates.
 #[cfg(test)]
-#[path = "../tests/support/served.rs"]
+#[allow(dead_code)] // the tests here use part of it
+#[path = "../../tests/src/served.rs"]
 mod served;
 mod sim;
 

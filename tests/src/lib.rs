@@ -7,6 +7,7 @@ pub mod peer;
 pub mod python;
 pub mod recording;
 pub mod seed_sim;
+pub mod served;
 pub mod vcan;
 
 use std::path::{Path, PathBuf};

@@ -46,7 +46,8 @@ use eds2rust_runtime::{Frame, Instant, Service};
 use serde_json::{Value, json};
 
 use crate::peer::{PeerPort, PyPeer, hex, unhex};
-use crate::seed_sim::{Served, export_eds};
+use crate::seed_sim::export_eds;
+use crate::served::Served;
 
 /// The seed device the session simulates.
 pub const DEVICE: &str = "interroll_ec5000bi";

@@ -21,7 +21,8 @@ use eds2rust_runtime::{Instant, blocking};
 use eds2rust_sim::models;
 use eds2rust_sim::{Behaviour, Device};
 use eds2rust_tests::peer::PyPeer;
-use eds2rust_tests::seed_sim::{self, Served};
+use eds2rust_tests::seed_sim;
+use eds2rust_tests::served::Served;
 use serde_json::{Value, json};
 
 /// The EDS of a seed device, exported from its YAML table.

@@ -41,7 +41,7 @@ impl Sim {
         B::Event: Send,
     {
         let bus = VirtualBus::new();
-        let served = Served::start(bus.attach(), device);
+        let served = Served::booted(bus.attach(), device);
         Sim {
             bus,
             _served: served,

@@ -411,7 +411,7 @@ fn on_a_terminal_the_table_is_redrawn_in_place() {
 #[test]
 fn the_loop_on_the_virtual_bus_against_the_linak_simulator() {
     let bus = VirtualBus::new();
-    let sim = Served::start(bus.attach(), linak_techline::simulator);
+    let sim = Served::booted(bus.attach(), linak_techline::simulator);
     let mut monitor_port = bus.attach();
     let mut master = bus.attach();
     master

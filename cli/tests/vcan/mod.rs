@@ -5,7 +5,7 @@
 
 #![allow(dead_code)]
 
-#[path = "../support/served.rs"]
+#[path = "../../../tests/src/served.rs"]
 mod served;
 
 use std::io::{BufRead, BufReader, Read};
@@ -225,6 +225,6 @@ impl Sim {
         B::Event: Send,
     {
         let port = SocketCanBus::open(name).unwrap_or_else(|e| panic!("opening {name}: {e}"));
-        Sim(Served::start(port, device))
+        Sim(Served::booted(port, device))
     }
 }
