@@ -49,13 +49,18 @@ fn python_emcy(
     )
 }
 
+/// Python LocalNode `id` and our consumer of its EMCYs, on a port of
+/// python's bus.
+fn local_node(id: u8) -> (PeerPort, EmcyConsumer) {
+    py().command_ok(json!({"op": "local_node", "node": id}))
+        .unwrap_or_else(|e| panic!("{e}"));
+    (py().port(), EmcyConsumer::only(&[node(id)]))
+}
+
 #[test]
 fn python_emcy_decodes_in_our_consumer() {
     const ID: u8 = 0x40;
-    py().command_ok(json!({"op": "local_node", "node": ID}))
-        .unwrap_or_else(|e| panic!("{e}"));
-    let mut port = py().port();
-    let mut consumer = EmcyConsumer::only(&[node(ID)]);
+    let (mut port, mut consumer) = local_node(ID);
     let n = node(ID);
 
     // Code, register and all 5 manufacturer bytes.
@@ -102,10 +107,7 @@ fn python_emcy_decodes_in_our_consumer() {
 #[test]
 fn python_emcy_named_by_generated_error_table() {
     const ID: u8 = 0x41;
-    py().command_ok(json!({"op": "local_node", "node": ID}))
-        .unwrap_or_else(|e| panic!("{e}"));
-    let mut port = py().port();
-    let mut consumer = EmcyConsumer::only(&[node(ID)]);
+    let (mut port, mut consumer) = local_node(ID);
     for (code, name, known) in [
         (0x3211, "overvoltage", true),
         (0x5080, "smps", true),

@@ -262,39 +262,34 @@ fn python_nmt_commands_parse_with_our_slave() {
         }]
     );
 
-    // Resets: reported, then the slave is back in boot-up.
-    let frames = run(ID, 0x82, &mut slave);
-    assert_eq!(
-        parse_command(&frames[0]),
-        Some((NmtCommand::ResetCommunication, NmtTarget::Node(node(ID))))
-    );
-    assert_eq!(
-        events(&mut slave),
-        vec![
+    // Resets: reported, then the slave is back in boot-up (and boots again).
+    for (code, command, reset, from) in [
+        (
+            0x82,
+            NmtCommand::ResetCommunication,
             NmtSlaveEvent::ResetCommunication,
-            NmtSlaveEvent::StateChanged {
-                from: Operational,
-                to: BootUp
-            }
-        ]
-    );
-    slave.boot_complete();
-    let _ = events(&mut slave);
-    let frames = run(ID, 0x81, &mut slave);
-    assert_eq!(
-        parse_command(&frames[0]),
-        Some((NmtCommand::ResetNode, NmtTarget::Node(node(ID))))
-    );
-    assert_eq!(
-        events(&mut slave),
-        vec![
+            Operational,
+        ),
+        (
+            0x81,
+            NmtCommand::ResetNode,
             NmtSlaveEvent::ResetNode,
-            NmtSlaveEvent::StateChanged {
-                from: PreOperational,
-                to: BootUp
-            }
-        ]
-    );
+            PreOperational,
+        ),
+    ] {
+        let frames = run(ID, code, &mut slave);
+        assert_eq!(
+            parse_command(&frames[0]),
+            Some((command, NmtTarget::Node(node(ID))))
+        );
+        let to = BootUp;
+        assert_eq!(
+            events(&mut slave),
+            vec![reset, NmtSlaveEvent::StateChanged { from, to }]
+        );
+        slave.boot_complete();
+        let _ = events(&mut slave);
+    }
 }
 
 #[test]
