@@ -11,14 +11,10 @@ entry of "report" (null: nothing stored and no default). Any failure prints
 
 import json
 import sys
-import traceback
 
 import canopen
 
-
-def emit(obj):
-    sys.stdout.write(json.dumps(obj) + "\n")
-    sys.stdout.flush()
+from json_lines import emit, run
 
 
 def key(text):
@@ -49,9 +45,4 @@ def main():
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except Exception as e:  # noqa: BLE001 - reported to the Rust side
-        traceback.print_exc()
-        emit({"error": "%s: %s" % (type(e).__name__, e)})
-        sys.exit(1)
+    run(main)

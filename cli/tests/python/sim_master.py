@@ -19,20 +19,16 @@ import json
 import struct
 import sys
 import time
-import traceback
 
 import canopen
+
+from json_lines import emit, run
 from canopen.objectdictionary import ObjectDictionary
 
 # Controlword, then the statusword bits 0-3, 5, 6 of the state it leads to
 # (CiA 402: Ready to switch on, Switched on, Operation enabled).
 ENABLE = [(0x06, 0x21), (0x07, 0x23), (0x0F, 0x27)]
 STATE_MASK = 0x6F
-
-
-def emit(obj):
-    sys.stdout.write(json.dumps(obj) + "\n")
-    sys.stdout.flush()
 
 
 def main():
@@ -88,9 +84,4 @@ def main():
 
 
 if __name__ == "__main__":
-    try:
-        main()
-    except Exception as e:  # noqa: BLE001 - reported to the Rust side
-        traceback.print_exc()
-        emit({"error": "%s: %s" % (type(e).__name__, e)})
-        sys.exit(1)
+    run(main)
