@@ -36,7 +36,16 @@ impl Served {
         P: Bus + Send + 'static,
         S: Service + Send + 'static,
     {
-        Served::spawn(port, Clock::new(), make, true)
+        Served::booted_on(port, Clock::new(), make)
+    }
+
+    /// [`Served::booted`] on `clock` (a clone of the test's own clock).
+    pub fn booted_on<P, S>(port: P, clock: Clock, make: impl FnOnce(Instant) -> S) -> Served
+    where
+        P: Bus + Send + 'static,
+        S: Service + Send + 'static,
+    {
+        Served::spawn(port, clock, make, true)
     }
 
     fn spawn<P, S>(mut port: P, clock: Clock, make: impl FnOnce(Instant) -> S, boot: bool) -> Served

@@ -7,6 +7,7 @@ use eds2rust::input::Options;
 use eds2rust_runtime::transport::virtual_bus::VirtualBus;
 
 use super::*;
+use crate::served::Served;
 
 fn machine() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../eds/machine/bus.yml")
@@ -18,16 +19,22 @@ fn plan(path: &std::path::Path) -> NetworkPlan {
     eds2rust::network::boot_plan(&network.bus, &network.configured)
 }
 
+/// The seed machine's plan (each slave's response time `response`, no
+/// boot time) booted on an empty virtual bus for at most `timeout`.
+fn boot_empty(response: Duration, timeout: Duration) -> (NetworkPlan, Outcome) {
+    let mut plan = plan(&machine());
+    plan.response_time = response;
+    plan.boot_time = None;
+    let bus = VirtualBus::new();
+    let (_, outcome) = boot(bus.attach(), Clock::new(), &plan, timeout).expect("the boot runs");
+    (plan, outcome)
+}
+
 /// Nobody on the bus: every slave fails with status B once the response
 /// time is over; the network does not boot.
 #[test]
 fn an_empty_bus_fails_every_slave_with_status_b() {
-    let mut plan = plan(&machine());
-    plan.response_time = Duration::from_millis(50);
-    plan.boot_time = None;
-    let bus = VirtualBus::new();
-    let (_, outcome) =
-        boot(bus.attach(), Clock::new(), &plan, Duration::from_secs(5)).expect("the boot runs");
+    let (plan, outcome) = boot_empty(Duration::from_millis(50), Duration::from_secs(5));
     assert_eq!(
         outcome.decided,
         Some(!plan.slaves.iter().any(|s| s.mandatory))
@@ -47,31 +54,17 @@ fn an_empty_bus_fails_every_slave_with_status_b() {
 /// sim --network` serves it on an interface), the master on another.
 #[test]
 fn the_seed_machine_boots_on_the_real_clock_against_its_simulation_in_a_thread() {
-    use std::sync::Arc;
-    use std::sync::atomic::{AtomicBool, Ordering};
-
-    use eds2rust_runtime::Service;
-
     let network = crate::net::load::read_configured(&machine(), &Options::default(), "booted")
         .expect("the bus file reads");
     let plan = eds2rust::network::boot_plan(&network.bus, &network.configured);
     let simulated = eds2rust_sim::network::Network::from_bus(&network.bus, &network.configured);
     let bus = VirtualBus::new();
     let clock = Clock::new();
-    let mut port = bus.attach();
-    let mut sim = simulated.simulation(&[], clock.now()).expect("no faults");
-    while let Some(frame) = sim.poll_transmit() {
-        port.send(&frame).unwrap();
-    }
-    let stop = Arc::new(AtomicBool::new(false));
-    let flag = Arc::clone(&stop);
-    let serve_clock = clock.clone();
-    let thread = std::thread::spawn(move || {
-        eds2rust_runtime::blocking::serve(&mut port, &serve_clock, &mut sim, &flag, None, |_| {})
+    let served = Served::booted_on(bus.attach(), clock.clone(), |now| {
+        simulated.simulation(&[], now).expect("no faults")
     });
     let result = boot(bus.attach(), clock, &plan, default_timeout(&plan));
-    stop.store(true, Ordering::Relaxed);
-    thread.join().unwrap().unwrap();
+    served.finish().unwrap();
     let (_, outcome) = result.expect("the boot runs");
     let text = render_text("bus.yml", &plan, &outcome);
     assert!(outcome.running(&plan), "{text}");
@@ -83,12 +76,7 @@ fn the_seed_machine_boots_on_the_real_clock_against_its_simulation_in_a_thread()
 /// time so far), the summary names them; not running.
 #[test]
 fn a_boot_not_decided_in_time_lists_the_slaves_still_booting() {
-    let mut plan = plan(&machine());
-    plan.response_time = Duration::from_secs(10);
-    plan.boot_time = None;
-    let bus = VirtualBus::new();
-    let (_, outcome) =
-        boot(bus.attach(), Clock::new(), &plan, Duration::from_millis(30)).expect("the boot runs");
+    let (plan, outcome) = boot_empty(Duration::from_secs(10), Duration::from_millis(30));
     assert_eq!(outcome.decided, None);
     assert!(!outcome.running(&plan));
     let text = render_text("bus.yml", &plan, &outcome);
