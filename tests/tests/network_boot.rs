@@ -228,14 +228,7 @@ fn a_mandatory_slave_booting_after_the_boot_time_fails_the_network_then_boots() 
     // When it finally comes, it is booted (the failed network does not
     // start it).
     rig.run(Duration::from_millis(1000));
-    let comes = rig.position("Rebooting", |e| *e == NetworkEvent::Rebooting(id(LEFT)));
-    let booted = rig.events[comes..].iter().any(|e| {
-        *e == NetworkEvent::Step {
-            node: id(LEFT),
-            step: BootEvent::Booted,
-        }
-    });
-    assert!(booted, "{:#?}", rig.events);
+    rig.rebooted(LEFT);
     let status = rig.slave(LEFT);
     assert_eq!(status.state, SlaveState::Booted, "{status:#?}");
     assert_eq!(status.error, None);

@@ -125,6 +125,18 @@ impl Rig {
     }
 
     /// The position of the first event `matches` takes (panics without).
+    /// Where slave `node`'s reboot begins (`Rebooting`); the test fails
+    /// unless a `Booted` step of `node` follows.
+    pub fn rebooted(&self, node: u8) -> usize {
+        let at = self.position("Rebooting", |e| *e == NetworkEvent::Rebooting(id(node)));
+        let booted = NetworkEvent::Step {
+            node: id(node),
+            step: BootEvent::Booted,
+        };
+        assert!(self.events[at..].contains(&booted), "{:#?}", self.events);
+        at
+    }
+
     pub fn position(&self, what: &str, matches: impl Fn(&NetworkEvent) -> bool) -> usize {
         self.events
             .iter()
