@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use eds2rust::network::model::{Bus, CobIdSetting, SlaveSection, Spot};
+use eds2rust::network::model::{Bus, CobIdSetting, PdoSection, SlaveSection, Spot};
 use eds2rust::network::{BusLoaded, read_file};
 use eds2rust::read::Options;
 
@@ -26,6 +26,12 @@ fn read(path: &Path) -> (Bus, BusLoaded) {
     );
     let bus = loaded.bus.take().expect("a bus");
     (bus, loaded)
+}
+
+/// The (index, sub) of each entry a PDO section maps.
+fn mapping(pdo: &PdoSection) -> Vec<(u16, u8)> {
+    let items = pdo.mapping.as_ref().expect("a mapping");
+    items.iter().map(|m| (m.index, m.sub_index)).collect()
 }
 
 /// A slave with every spot blanked, as text: what two spellings of one
@@ -153,24 +159,13 @@ fn prbt_pilz6() {
         assert!(t1.enabled.value);
         assert_eq!(t1.cob_id.as_ref().unwrap().value, CobIdSetting::Auto);
         assert_eq!(t1.transmission.as_ref().unwrap().value, 1);
-        let mapping: Vec<_> = t1
-            .mapping
-            .as_ref()
-            .unwrap()
-            .iter()
-            .map(|m| (m.index, m.sub_index))
-            .collect();
-        assert_eq!(mapping, [(0x6041, 0), (0x6061, 0)]);
+        assert_eq!(mapping(t1), [(0x6041, 0), (0x6061, 0)]);
         assert!(!slave.tpdo[&3].enabled.value);
         assert!(slave.tpdo[&3].mapping.is_none());
-        let r1: Vec<_> = slave.rpdo[&1]
-            .mapping
-            .as_ref()
-            .unwrap()
-            .iter()
-            .map(|m| (m.index, m.sub_index))
-            .collect();
-        assert_eq!(r1, [(0x6040, 0), (0x6060, 0), (0x60C1, 1)]);
+        assert_eq!(
+            mapping(&slave.rpdo[&1]),
+            [(0x6040, 0), (0x6060, 0), (0x60C1, 1)]
+        );
         let sdo: Vec<_> = slave
             .sdo
             .iter()
