@@ -13,37 +13,28 @@ fn run(args: &[&str]) -> (i32, String, String) {
     common::run_in(&root(), args)
 }
 
+/// `eds2rust net boot --simulate ARGS...` in the workspace root.
+fn simulate(args: &[&str]) -> (i32, String, String) {
+    run(&[&["net", "boot", "--simulate"][..], args].concat())
+}
+
 /// `net boot --simulate --run --duration DURATION` of the fault-matrix
 /// network with `fault`, then `more` arguments.
 fn run_matrix(fault: &str, duration: &str, more: &[&str]) -> (i32, String, String) {
-    let args = [
-        "net",
-        "boot",
-        "--simulate",
-        "--fault",
-        fault,
-        "--run",
-        "--duration",
-        duration,
-    ];
-    run(&[&args[..], more, &["tests/networks/boot/matrix.yml"]].concat())
+    let args = ["--fault", fault, "--run", "--duration", duration];
+    simulate(&[&args[..], more, &["tests/networks/boot/matrix.yml"]].concat())
 }
 
 #[test]
 fn the_seed_machine_boots_in_its_simulation() {
-    let (code, stdout, stderr) = run(&["net", "boot", "--simulate", "eds/machine/bus.yml"]);
+    let (code, stdout, stderr) = simulate(&["eds/machine/bus.yml"]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     insta::assert_snapshot!("net_boot_seed_machine", stdout);
 }
 
 #[test]
 fn every_slave_row_says_what_its_boot_did() {
-    let (code, stdout, stderr) = run(&[
-        "net",
-        "boot",
-        "--simulate",
-        "tests/networks/boot/matrix.yml",
-    ]);
+    let (code, stdout, stderr) = simulate(&["tests/networks/boot/matrix.yml"]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     let rows: Vec<Vec<&str>> = stdout
         .lines()
@@ -99,14 +90,8 @@ fn every_slave_row_says_what_its_boot_did() {
 /// summary naming the slave, its node and the status.
 #[test]
 fn a_missing_mandatory_slave_fails_the_boot_with_status_b() {
-    let (code, stdout, stderr) = run(&[
-        "net",
-        "boot",
-        "--simulate",
-        "--fault",
-        "left:missing",
-        "tests/networks/boot/matrix.yml",
-    ]);
+    let (code, stdout, stderr) =
+        simulate(&["--fault", "left:missing", "tests/networks/boot/matrix.yml"]);
     assert_eq!(code, 1, "{stdout}{stderr}");
     let row = |node: &str| row(&stdout, node);
     assert_eq!(
@@ -133,14 +118,8 @@ fn a_missing_mandatory_slave_fails_the_boot_with_status_b() {
 
     // The optional slave missing: the network runs (exit status 0), the
     // summary names the slave that is not up.
-    let (code, stdout, stderr) = run(&[
-        "net",
-        "boot",
-        "--simulate",
-        "--fault",
-        "3:missing",
-        "tests/networks/boot/matrix.yml",
-    ]);
+    let (code, stdout, stderr) =
+        simulate(&["--fault", "3:missing", "tests/networks/boot/matrix.yml"]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     assert!(
         stdout.ends_with("optional slaves not up: right (node 3) B\n"),
@@ -148,14 +127,8 @@ fn a_missing_mandatory_slave_fails_the_boot_with_status_b() {
     );
 
     // A wrong identity: status O, with the expected and found values.
-    let (code, stdout, _) = run(&[
-        "net",
-        "boot",
-        "--simulate",
-        "--fault",
-        "left:serial=5",
-        "tests/networks/boot/matrix.yml",
-    ]);
+    let (code, stdout, _) =
+        simulate(&["--fault", "left:serial=5", "tests/networks/boot/matrix.yml"]);
     assert_eq!(code, 1, "{stdout}");
     assert!(
         stdout.contains("| wrong ") && stdout.contains("expected 0x00C0FFEE, found 0x00000005"),
@@ -165,14 +138,7 @@ fn a_missing_mandatory_slave_fails_the_boot_with_status_b() {
 
 #[test]
 fn json_has_the_outcome_and_every_slave() {
-    let (code, stdout, stderr) = run(&[
-        "net",
-        "boot",
-        "--simulate",
-        "--format",
-        "json",
-        "tests/networks/boot/matrix.yml",
-    ]);
+    let (code, stdout, stderr) = simulate(&["--format", "json", "tests/networks/boot/matrix.yml"]);
     assert_eq!(code, 0, "{stdout}{stderr}");
     let v: serde_json::Value = serde_json::from_str(&stdout).expect("one JSON object");
     assert_eq!(v["running"], true);
@@ -192,21 +158,10 @@ fn usage_and_input_errors() {
     let bus = "tests/networks/boot/matrix.yml";
     // Neither --iface nor --simulate, or both: usage errors.
     assert_eq!(run(&["net", "boot", bus]).0, 2);
-    assert_eq!(
-        run(&["net", "boot", "--simulate", "--iface", "vcan0", bus]).0,
-        2
-    );
-    assert_eq!(
-        run(&["net", "boot", "--simulate", "--timeout", "0", bus]).0,
-        2
-    );
+    assert_eq!(simulate(&["--iface", "vcan0", bus]).0, 2);
+    assert_eq!(simulate(&["--timeout", "0", bus]).0, 2);
     // A bus file with errors is not booted.
-    let (code, _, stderr) = run(&[
-        "net",
-        "boot",
-        "--simulate",
-        "tests/networks/check/node-id/bus.yml",
-    ]);
+    let (code, _, stderr) = simulate(&["tests/networks/check/node-id/bus.yml"]);
     assert_eq!(code, 1, "{stderr}");
     assert!(stderr.contains("not booted:"), "{stderr}");
     // An interface that is not there: 1, naming it.
@@ -272,11 +227,8 @@ fn run_keeps_the_network_and_boots_a_returning_slave_again() {
 
     // With --simulate --run needs a time; --duration needs --run.
     let bus = "tests/networks/boot/matrix.yml";
-    assert_eq!(run(&["net", "boot", "--simulate", "--run", bus]).0, 2);
-    assert_eq!(
-        run(&["net", "boot", "--simulate", "--duration", "1s", bus]).0,
-        2
-    );
+    assert_eq!(simulate(&["--run", bus]).0, 2);
+    assert_eq!(simulate(&["--duration", "1s", bus]).0, 2);
 }
 
 /// The blocks of docs/network.md's `## net boot` marked `<!-- output:
