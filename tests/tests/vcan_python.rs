@@ -13,6 +13,7 @@ use std::io::{BufRead, BufReader, Write};
 use std::process::{Child, ChildStdin, ChildStdout, Command};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use eds2rust_runtime::blocking::{self, SdoClient};
@@ -106,6 +107,29 @@ impl Drop for Peer {
             let _ = self.child.kill();
             let _ = self.child.wait();
         }
+    }
+}
+
+/// A service of ours served (`blocking::serve` with the flag it is given)
+/// in a thread, until [`Serving::stop`], which gives what the thread
+/// returned.
+struct Serving<T> {
+    stop: Arc<AtomicBool>,
+    thread: JoinHandle<std::io::Result<T>>,
+}
+
+impl<T: Send + 'static> Serving<T> {
+    fn start(serve: impl FnOnce(&AtomicBool) -> std::io::Result<T> + Send + 'static) -> Self {
+        let stop = Arc::new(AtomicBool::new(false));
+        let flag = Arc::clone(&stop);
+        let thread = std::thread::spawn(move || serve(&flag));
+        Serving { stop, thread }
+    }
+
+    /// Stops it; what it returned (a failed bus or a panic fails the test).
+    fn stop(self) -> T {
+        self.stop.store(true, Ordering::Relaxed);
+        self.thread.join().unwrap().unwrap()
     }
 }
 
@@ -209,9 +233,7 @@ fn python_remote_node_against_our_sdo_server() {
     store.insert(0x2004, 0, AccessRight::Rw, &[0x00]);
 
     let server_bus = open(&name).set_id_filters(&[channel.request]).unwrap();
-    let stop = Arc::new(AtomicBool::new(false));
-    let server_stop = Arc::clone(&stop);
-    let server = std::thread::spawn(move || {
+    let server = Serving::start(move |server_stop| {
         let mut bus = server_bus;
         drain(&mut bus);
         // python-canopen reads block segments one by one in python, which
@@ -224,7 +246,7 @@ fn python_remote_node_against_our_sdo_server() {
             &mut bus,
             &Clock::new(),
             &mut server,
-            &server_stop,
+            server_stop,
             Some(deadline),
             |_| {},
         )
@@ -245,8 +267,7 @@ fn python_remote_node_against_our_sdo_server() {
         ],
     }));
     let reply = peer.finish();
-    stop.store(true, Ordering::Relaxed);
-    let store = server.join().unwrap().unwrap();
+    let store = server.stop();
     assert_eq!(
         reply["results"],
         json!([
@@ -310,9 +331,7 @@ fn python_nmt_master_commands_our_slave() {
     assert_eq!(peer.read(), json!({"ready": true}));
 
     let device_bus = open(&name).set_filters(&[(0x000, 0x7FF)]).unwrap();
-    let stop = Arc::new(AtomicBool::new(false));
-    let device_stop = Arc::clone(&stop);
-    let device = std::thread::spawn(move || {
+    let device = Serving::start(move |device_stop| {
         let mut bus = device_bus;
         drain(&mut bus);
         let clock = Clock::new();
@@ -329,7 +348,7 @@ fn python_nmt_master_commands_our_slave() {
             &mut bus,
             &clock,
             &mut device,
-            &device_stop,
+            device_stop,
             Some(deadline),
             |e| events.push(e),
         )
@@ -337,8 +356,7 @@ fn python_nmt_master_commands_our_slave() {
     });
 
     let reply = peer.finish();
-    stop.store(true, Ordering::Relaxed);
-    let events = device.join().unwrap().unwrap();
+    let events = device.stop();
     assert_eq!(
         reply["reached"],
         json!([
@@ -423,26 +441,16 @@ fn our_pdo_transmitter_decoded_by_python_tpdo_map() {
     config.event_timer = EventTimer(50);
     let data = [0x37, 0x02, 0x18, 0xFC, 0xFF, 0xFF, 0x03];
     let bus = open(&name).set_filters(&[]).unwrap();
-    let stop = Arc::new(AtomicBool::new(false));
-    let pdo_stop = Arc::clone(&stop);
-    let sender = std::thread::spawn(move || {
+    let sender = Serving::start(move |pdo_stop| {
         let mut bus = bus;
         let clock = Clock::new();
         let mut pdo = PdoTransmitter::new(config).unwrap();
         pdo.set_data(clock.now(), &data).unwrap();
         let deadline = Instant::now() + Duration::from_secs(60);
-        blocking::serve(
-            &mut bus,
-            &clock,
-            &mut pdo,
-            &pdo_stop,
-            Some(deadline),
-            |_| {},
-        )
+        blocking::serve(&mut bus, &clock, &mut pdo, pdo_stop, Some(deadline), |_| {})
     });
     let reply = peer.finish();
-    stop.store(true, Ordering::Relaxed);
-    sender.join().unwrap().unwrap();
+    sender.stop();
     assert_eq!(reply["data"], "370218FCFFFF03");
     assert_eq!(reply["values"], json!([0x0237, -1000, 3]));
 }
