@@ -38,6 +38,20 @@ fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
     path
 }
 
+/// The DCF built as device `drive` into `out`, with the rule levels
+/// `levels` sets, without cargo's output.
+fn build_drive(
+    dcf: &Path,
+    out: PathBuf,
+    levels: impl FnOnce(&mut Builder) -> &mut Builder,
+) -> Result<eds2rust::build::Report, eds2rust::build::Error> {
+    let mut builder = Builder::new();
+    levels(builder.device("drive", dcf))
+        .out_dir(out)
+        .cargo_output(false)
+        .build()
+}
+
 fn of_code<'a>(diags: impl IntoIterator<Item = &'a Diagnostic>, code: &str) -> Vec<&'a Diagnostic> {
     diags.into_iter().filter(|d| d.code == code).collect()
 }
@@ -136,24 +150,12 @@ fn builder_allow_and_deny() {
         return;
     };
     let dir = scratch("builder");
-    let report = Builder::new()
-        .device("drive", &dcf)
-        .allow("eds::unknown-section")
-        .out_dir(dir.join("out"))
-        .cargo_output(false)
-        .build()
-        .unwrap();
+    let report = build_drive(&dcf, dir.join("out"), |b| b.allow("eds::unknown-section")).unwrap();
     assert!(of_code(report.warnings.iter(), "eds::unknown-section").is_empty());
     assert_eq!(report.warnings.allowed_count(), 1);
     assert_eq!(of_code(report.warnings.iter(), "eds::pdo-mapping").len(), 1);
 
-    let err = Builder::new()
-        .device("drive", &dcf)
-        .deny("eds::pdo-mapping")
-        .out_dir(dir.join("out2"))
-        .cargo_output(false)
-        .build()
-        .unwrap_err();
+    let err = build_drive(&dcf, dir.join("out2"), |b| b.deny("eds::pdo-mapping")).unwrap_err();
     let text = err.to_string();
     let first = text.lines().next().unwrap();
     assert!(
@@ -180,13 +182,8 @@ fn builder_allow_and_deny() {
         "{cargo:?}"
     );
 
-    let err = Builder::new()
-        .device("drive", &dcf)
-        .allow("eds::unknown-sections")
-        .out_dir(dir.join("out3"))
-        .cargo_output(false)
-        .build()
-        .unwrap_err();
+    let err =
+        build_drive(&dcf, dir.join("out3"), |b| b.allow("eds::unknown-sections")).unwrap_err();
     let unknown = of_code(err.diagnostics().iter(), "build::unknown-rule");
     assert_eq!(unknown.len(), 1);
     assert!(
