@@ -38,6 +38,21 @@ fn one(changes: &[Change], what: &str) -> Change {
     changes[0].clone()
 }
 
+/// `change` is a `kind` change of `severity` at (index, sub) `at`.
+fn assert_change(
+    change: &Change,
+    at: (u16, Option<u8>),
+    kind: Kind,
+    severity: Severity,
+    what: &str,
+) {
+    assert_eq!(
+        (change.index, change.subindex, change.kind, change.severity),
+        (at.0, at.1, kind, severity),
+        "{what}"
+    );
+}
+
 #[test]
 fn corpus_files_against_themselves_and_mutations() {
     let Some(files) = eds2rust_tests::corpus_files("diff corpus test") else {
@@ -100,16 +115,8 @@ fn corpus_files_against_themselves_and_mutations() {
         if let Some((index, entry)) = rw {
             let mutated = read_only(&device, index, entry.subindex);
             let c = one(&diff::diff(&device, &mutated), &name);
-            assert_eq!(
-                (c.index, c.subindex, c.kind, c.severity),
-                (
-                    index,
-                    Some(entry.subindex),
-                    Kind::AccessChanged,
-                    Severity::Breaking
-                ),
-                "{name}"
-            );
+            let at = (index, Some(entry.subindex));
+            assert_change(&c, at, Kind::AccessChanged, Severity::Breaking, &name);
             // The other way it widens.
             let c = one(&diff::diff(&mutated, &device), &name);
             assert_eq!(
@@ -176,16 +183,8 @@ fn corpus_files_against_themselves_and_mutations() {
                 *v ^= 1;
             }
             let c = one(&diff::diff(&device, &mutated), &name);
-            assert_eq!(
-                (c.index, c.subindex, c.kind, c.severity),
-                (
-                    index,
-                    Some(entry.subindex),
-                    Kind::DefaultChanged,
-                    Severity::Compatible
-                ),
-                "{name}"
-            );
+            let at = (index, Some(entry.subindex));
+            assert_change(&c, at, Kind::DefaultChanged, Severity::Compatible, &name);
             counts[2] += 1;
         }
 

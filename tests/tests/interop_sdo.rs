@@ -424,6 +424,11 @@ fn upload_cmd(id: u8, index: u16, block: Option<bool>) -> Value {
     }
 }
 
+/// Our server reported `event` (among its `events`).
+fn assert_reported(events: &[ServerEvent], event: ServerEvent, what: &str) {
+    assert!(events.contains(&event), "{what}: our events {events:?}");
+}
+
 fn python_uploads(id: u8, block: Option<bool>) {
     let mut served = Served::new(id);
     for (i, &len) in SIZES.iter().enumerate() {
@@ -436,14 +441,9 @@ fn python_uploads(id: u8, block: Option<bool>) {
             pattern(len),
             "{what}"
         );
-        assert!(
-            events.contains(&ServerEvent::Uploaded {
-                index: index_of(i),
-                sub: 0,
-                len
-            }),
-            "{what}: our events {events:?}"
-        );
+        let sub = 0;
+        let index = index_of(i);
+        assert_reported(&events, ServerEvent::Uploaded { index, sub, len }, &what);
     }
 }
 
@@ -467,14 +467,9 @@ fn python_downloads(id: u8, mode: Value) {
             py().failure(&format!("{what}: {outcome:?}; our events {events:?}"))
         );
         assert_eq!(served.stored(index_of(i)), data, "{what}");
-        assert!(
-            events.contains(&ServerEvent::Downloaded {
-                index: index_of(i),
-                sub: 0,
-                len
-            }),
-            "{what}: our events {events:?}"
-        );
+        let sub = 0;
+        let index = index_of(i);
+        assert_reported(&events, ServerEvent::Downloaded { index, sub, len }, &what);
     }
 }
 
