@@ -13,7 +13,7 @@
 
 mod vcan;
 
-use vcan::{Sim, fails, iface, ok, python, scratch};
+use vcan::{Sim, fails, iface, ok, python, rig, scratch, write_file};
 
 use std::io::{BufRead, BufReader, Write};
 use std::process::Stdio;
@@ -35,12 +35,6 @@ const LINAK: &str = include_str!("../../eds/linak_techline.yaml");
 const INTERROLL: &str = include_str!("../../eds/interroll_ec5000bi.yaml");
 const EXAMPLE_EDS: &str = include_str!("../../eds/example.eds");
 
-fn write_file(dir: &std::path::Path, name: &str, text: &str) -> String {
-    let path = dir.join(name);
-    std::fs::write(&path, text).unwrap();
-    path.display().to_string()
-}
-
 /// The text of section `[name]` of an EDS/DCF, up to the next section.
 fn section<'a>(text: &'a str, name: &str) -> &'a str {
     let head = format!("[{name}]\n");
@@ -54,10 +48,12 @@ fn section<'a>(text: &'a str, name: &str) -> &'a str {
 #[test]
 #[ignore = "needs vcan: tests/vm/run.sh"]
 fn sdo_read_write_typed_and_raw() {
-    let i = iface(SDO);
-    let dir = scratch("live-vcan", "sdo");
-    let od = write_file(&dir, "zimmer_acs.yaml", ZIMMER);
-    let _sim = Sim::start(&i, zimmer_acs::simulator);
+    let (i, dir, od, _sim) = rig(
+        SDO,
+        ("live-vcan", "sdo"),
+        ("zimmer_acs.yaml", ZIMMER),
+        zimmer_acs::simulator,
+    );
     let base = ["--iface", i.as_str(), "--node", "40", "--timeout", "2s"];
     let sdo = |verb: &str, rest: &[&str]| -> Vec<String> {
         ["sdo", verb]
@@ -132,10 +128,12 @@ fn sdo_read_write_typed_and_raw() {
 #[test]
 #[ignore = "needs vcan: tests/vm/run.sh"]
 fn nmt_and_scan_find_the_node_with_its_identity() {
-    let i = iface(NMT_SCAN);
-    let dir = scratch("live-vcan", "nmt");
-    let od = write_file(&dir, "linak.yaml", LINAK);
-    let _sim = Sim::start(&i, linak_techline::simulator);
+    let (i, _, od, _sim) = rig(
+        NMT_SCAN,
+        ("live-vcan", "nmt"),
+        ("linak.yaml", LINAK),
+        linak_techline::simulator,
+    );
     ok(&[
         "sdo",
         "write",
@@ -309,11 +307,13 @@ fn lss_fastscan_and_set_node_id() {
 #[test]
 #[ignore = "needs vcan: tests/vm/run.sh"]
 fn od_upload_then_download_restores_a_changed_value() {
-    let i = iface(BACKUP);
-    let dir = scratch("live-vcan", "backup");
-    let od = write_file(&dir, "zimmer_acs.yaml", ZIMMER);
+    let (i, dir, od, _sim) = rig(
+        BACKUP,
+        ("live-vcan", "backup"),
+        ("zimmer_acs.yaml", ZIMMER),
+        zimmer_acs::simulator,
+    );
     let dcf = dir.join("node40.dcf").display().to_string();
-    let _sim = Sim::start(&i, zimmer_acs::simulator);
     let common = ["-i", i.as_str(), "--timeout", "2s"];
     ok(&[
         &["od", "upload"][..],

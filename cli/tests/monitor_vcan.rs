@@ -13,7 +13,7 @@
 
 mod vcan;
 
-use vcan::{Ended, Running, Sim, fails, iface, ok, scratch};
+use vcan::{Ended, Running, fails, ok, rig};
 
 use std::path::Path;
 use std::time::Duration;
@@ -233,15 +233,15 @@ fn check_plot(ended: &Ended, svg: &Path) {
 #[test]
 #[ignore = "needs vcan: tests/vm/run.sh"]
 fn monitor_streams_tables_and_plots_the_linak_actuator() {
-    let i = iface(MONITOR);
-    let dir = scratch("monitor-vcan", "linak");
-    let od = dir.join("linak_techline.yaml");
-    std::fs::write(&od, LINAK).unwrap();
-    let od = od.display().to_string();
+    let (i, dir, od, _sim) = rig(
+        MONITOR,
+        ("monitor-vcan", "linak"),
+        ("linak_techline.yaml", LINAK),
+        linak_techline::simulator,
+    );
     let node = format!("32={od}");
     let svg = dir.join("position.svg");
     let svg_arg = svg.display().to_string();
-    let _sim = Sim::start(&i, linak_techline::simulator);
 
     let base = ["monitor", "-i", i.as_str(), "--node", node.as_str()];
     let with = |rest: &[&'static str]| [&base[..], rest].concat();

@@ -51,6 +51,34 @@ pub fn scratch(test: &str, name: &str) -> PathBuf {
     dir
 }
 
+/// Writes `text` to `dir/name`; its path.
+pub fn write_file(dir: &std::path::Path, name: &str, text: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path.display().to_string()
+}
+
+/// What a test with one simulated seed device starts from, on interface
+/// `index` of `CAN_IFACES`: the interface, the scratch directory of test
+/// `name` of `test`, the seed file `(file name, text)` written there (its
+/// path), and `device` simulated on the interface.
+pub fn rig<B>(
+    index: usize,
+    (test, name): (&str, &str),
+    (file, text): (&str, &str),
+    device: impl FnOnce(Instant) -> Device<B>,
+) -> (String, PathBuf, String, Sim)
+where
+    B: Behaviour + Send + 'static,
+    B::Event: Send,
+{
+    let iface = iface(index);
+    let dir = scratch(test, name);
+    let od = write_file(&dir, file, text);
+    let sim = Sim::start(&iface, device);
+    (iface, dir, od, sim)
+}
+
 /// Runs the CLI; prints the command line and its output.
 pub fn run<S: AsRef<str>>(args: &[S]) -> Output {
     let args: Vec<&str> = args.iter().map(AsRef::as_ref).collect();
