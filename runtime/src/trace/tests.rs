@@ -1,14 +1,7 @@
+use super::test_support::{Rng, ext_frame, std_frame};
 use super::*;
 use crate::CanId;
-use std::io::Read;
-
-fn std_frame(id: u16, data: &[u8]) -> Frame {
-    Frame::new(CanId::Standard(id), data).unwrap()
-}
-
-fn ext_frame(id: u32, data: &[u8]) -> Frame {
-    Frame::new(CanId::Extended(id), data).unwrap()
-}
+use std::io::{self, Read};
 
 fn remote(id: u16, len: u8) -> Frame {
     Frame::remote(CanId::Standard(id), len).unwrap()
@@ -346,7 +339,7 @@ fn long_lines_are_refused_without_storing_them() {
     input.extend(core::iter::repeat_n(b'B', MAX_LINE_LEN * 3)); // no line end
     let mut reader = Reader::new(&input[..]);
     let items: Vec<_> = reader.by_ref().collect();
-    assert!(reader.buf.capacity() <= 4 * MAX_LINE_LEN);
+    assert!(reader.lines.buffer_capacity() <= 4 * MAX_LINE_LEN);
     let summary: Vec<_> = items
         .iter()
         .map(|r| match r {
@@ -434,18 +427,6 @@ fn read_failure_ends_the_reader() {
     );
 }
 
-/// A small xorshift generator: the test stays deterministic.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-}
-
 #[test]
 fn random_input_never_panics() {
     let pieces: [&[u8]; 24] = [
@@ -478,7 +459,7 @@ fn random_input_never_panics() {
     for _ in 0..300 {
         let mut bytes = Vec::new();
         for _ in 0..(rng.next() % 200) {
-            bytes.extend_from_slice(pieces[(rng.next() % pieces.len() as u64) as usize]);
+            bytes.extend_from_slice(pieces[rng.below(pieces.len())]);
         }
         let mut last = 0;
         for item in Reader::new(&bytes[..]) {
