@@ -23,7 +23,7 @@ use std::vec::Vec;
 
 use crate::od::{self, Entry};
 use crate::sdo::client::{self, ClientConfig, Method};
-use crate::sdo::typed::{self, LengthNote};
+use crate::sdo::typed::LengthNote;
 pub use crate::time::Deadline;
 use crate::transport::{Bus, Clock};
 use crate::{Frame, Instant, Service};
@@ -259,7 +259,7 @@ impl<B: Bus> SdoClient<B> {
     }
 
     /// The notes typed reads left since the last call (at most
-    /// [`typed::NOTES_KEPT`], the newest): values the server sent longer
+    /// [`NOTES_KEPT`](crate::sdo::typed::NOTES_KEPT), the newest): values the server sent longer
     /// than their data type, of which the leading bytes were taken. Empty
     /// with [`ClientConfig::strict_lengths`], which refuses them instead.
     pub fn take_length_notes(&mut self) -> Vec<LengthNote> {
@@ -458,12 +458,8 @@ impl<B: Bus> SdoClient<B> {
     {
         let upload = self.transfer(E::INDEX, sub, Transfer::Upload(Method::Auto))?;
         let strict = self.core.config().strict_lengths;
-        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)
-            .map_err(|e| self.object(E::INDEX, sub).value(e))?;
-        if let Some(note) = note {
-            typed::keep(&mut self.notes, note);
-        }
-        Ok(value)
+        let object = self.object(E::INDEX, sub);
+        upload.value::<E, _>(object, strict, &mut self.notes, |note| note)
     }
 
     /// Typed write of sub `sub` of `E`'s object.
@@ -473,8 +469,8 @@ impl<B: Bus> SdoClient<B> {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value, self.object(E::INDEX, sub))?;
-        self.download(E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
+        let encoded = encode::<E>(value, self.object(E::INDEX, sub))?;
+        self.download(E::INDEX, sub, encoded.bytes())
     }
 }
 

@@ -24,7 +24,7 @@ use crate::master::{self, MasterEvent};
 use crate::nmt::{NmtCommand, NmtTarget};
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::client::Method;
-use crate::sdo::typed::{self, LengthNote};
+use crate::sdo::typed::LengthNote;
 use crate::time::Deadline;
 use crate::transport::{Bus, Clock};
 use crate::{Instant, Service};
@@ -264,7 +264,7 @@ impl<B: Bus> Master<B> {
     }
 
     /// The notes typed reads left since the last call (at most
-    /// [`typed::NOTES_KEPT`], the newest), with the node: values a server
+    /// [`NOTES_KEPT`](crate::sdo::typed::NOTES_KEPT), the newest), with the node: values a server
     /// sent longer than their data type, of which the leading bytes were
     /// taken. Empty for nodes whose client has
     /// [`strict_lengths`](crate::sdo::client::ClientConfig::strict_lengths),
@@ -577,12 +577,8 @@ impl<B: Bus> Master<B> {
     {
         let upload = self.transfer(node, E::INDEX, sub, Transfer::Upload(Method::Auto))?;
         let strict = self.core.sdo_or_default(node).config().strict_lengths;
-        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)
-            .map_err(|e| Object::new(Some(node), E::INDEX, sub).value(e))?;
-        if let Some(note) = note {
-            typed::keep(&mut self.notes, (node, note));
-        }
-        Ok(value)
+        let object = Object::new(Some(node), E::INDEX, sub);
+        upload.value::<E, _>(object, strict, &mut self.notes, |note| (node, note))
     }
 
     /// Typed write of sub `sub` of `E`'s object.
@@ -592,8 +588,8 @@ impl<B: Bus> Master<B> {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value, Object::new(Some(node), E::INDEX, sub))?;
-        self.download(node, E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
+        let encoded = encode::<E>(value, Object::new(Some(node), E::INDEX, sub))?;
+        self.download(node, E::INDEX, sub, encoded.bytes())
     }
 }
 
