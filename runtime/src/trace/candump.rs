@@ -33,10 +33,7 @@ mod tests;
 
 pub use parse::{LogLineRef, parse_frame, parse_line, parse_line_ref};
 
-/// The longest line the [`Reader`] accepts, in bytes (a text-form line of an
-/// extended frame with a timestamp and a 15-character interface name is
-/// under 80).
-pub const MAX_LINE_LEN: usize = 1024;
+pub use super::lines::MAX_LINE_LEN;
 
 /// The interface name the [`Writer`] uses in the log and text forms for a
 /// line whose interface is empty.

@@ -1,12 +1,15 @@
-//! The line reading of the trace readers ([`super::candump::Reader`] and
-//! [`super::Reader`]): numbered lines of at most
+//! The line reading of the trace readers (`candump::Reader` and
+//! `trace::Reader`): numbered lines of at most
 //! [`MAX_LINE_LEN`] bytes, an over-long line consumed without being stored,
 //! and no more lines once reading failed.
 
 use std::io::{self, BufRead, Read};
 use std::vec::Vec;
 
-use super::candump::MAX_LINE_LEN;
+/// The longest line the readers accept, in bytes (a candump text-form
+/// line of an extended frame with a timestamp and a 15-character interface
+/// name is under 80).
+pub const MAX_LINE_LEN: usize = 1024;
 
 /// Why [`Lines::next_line`] gave no line.
 #[derive(Debug)]
