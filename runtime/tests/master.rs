@@ -3,6 +3,9 @@
 //! (node 0x20) served in a thread, with a monitor port recording every
 //! frame and when it was seen.
 
+#[macro_use]
+mod support;
+
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, mpsc};
@@ -15,7 +18,7 @@ use eds2rust_runtime::heartbeat::{HeartbeatEvent, HeartbeatProducer};
 use eds2rust_runtime::lss::LssState;
 use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtSlave, NmtState};
-use eds2rust_runtime::od::{AccessRight, DataType, Entry, NodeId, PdoDirection, access};
+use eds2rust_runtime::od::{AccessRight, PdoDirection};
 use eds2rust_runtime::pdo::{PdoCobId, PdoConfig, PdoEvent, TransmissionType};
 use eds2rust_runtime::sdo::client::Method;
 use eds2rust_runtime::sdo::server::{MemoryStore, ObjectStore, SdoServer, ServerConfig};
@@ -23,6 +26,7 @@ use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};
 use eds2rust_runtime::transport::Clock;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use eds2rust_runtime::{CanId, Frame, Instant, Service};
+use support::node;
 
 const DEVICE: u8 = 0x20;
 /// The master's heartbeat period.
@@ -30,42 +34,18 @@ const PERIOD: Duration = Duration::from_millis(20);
 /// How long the device takes to read its slow object unless released.
 const SLOW: Duration = Duration::from_millis(300);
 
-fn node(id: u8) -> NodeId {
-    NodeId::new(id).unwrap()
-}
+entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
 
-struct ProducerHeartbeatTime;
-impl Entry for ProducerHeartbeatTime {
-    const INDEX: u16 = 0x1017;
-    const SUBINDEX: u8 = 0;
-    const NAME: &'static str = "Producer heartbeat time";
-    const DATA_TYPE: DataType = DataType::Unsigned16;
-    const PDO_MAPPABLE: bool = false;
-    type Access = access::Rw;
-    type Value = u16;
-}
+entry!(SlowValue, 0x2000, 1, Unsigned32, Ro, u32);
 
-struct SlowValue;
-impl Entry for SlowValue {
-    const INDEX: u16 = 0x2000;
-    const SUBINDEX: u8 = 1;
-    const NAME: &'static str = "Slow value";
-    const DATA_TYPE: DataType = DataType::Unsigned32;
-    const PDO_MAPPABLE: bool = false;
-    type Access = access::Ro;
-    type Value = u32;
-}
-
-struct Blob;
-impl Entry for Blob {
-    const INDEX: u16 = 0x2100;
-    const SUBINDEX: u8 = 0;
-    const NAME: &'static str = "Blob";
-    const DATA_TYPE: DataType = DataType::Domain;
-    const PDO_MAPPABLE: bool = false;
-    type Access = access::Rw;
-    type Value = eds2rust_runtime::od::bytes::Domain;
-}
+entry!(
+    Blob,
+    0x2100,
+    0,
+    Domain,
+    Rw,
+    eds2rust_runtime::od::bytes::Domain
+);
 
 /// A memory store whose object 0x2000:01 takes [`SLOW`] to read, or less
 /// when released: it tells `started` when the read begins, then answers

@@ -2,10 +2,10 @@
 //! streams, their bounded queues, and LSS.
 #![cfg(feature = "tokio")]
 
-#[path = "tokio_master_rig.rs"]
-mod rig;
+#[macro_use]
+mod support;
 
-use rig::*;
+use support::tokio_rig::*;
 
 use std::time::Duration;
 

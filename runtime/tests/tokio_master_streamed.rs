@@ -5,10 +5,10 @@
 //! writing what came; the next transfer works after each.
 #![cfg(feature = "tokio")]
 
-#[path = "tokio_master_rig.rs"]
-mod rig;
+#[macro_use]
+mod support;
 
-use rig::*;
+use support::tokio_rig::*;
 
 use std::io::{self, Read};
 use std::time::Duration;

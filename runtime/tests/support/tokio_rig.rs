@@ -1,11 +1,10 @@
 //! The rig of the tokio master tests (`tokio_master.rs`,
-//! `tokio_master_events.rs`): the virtual bus under tokio's paused clock,
+//! `tokio_master_events.rs`, `tokio_master_pdo.rs`,
+//! `tokio_master_streamed.rs`): the virtual bus under tokio's paused clock,
 //! the master and its driver task, a device assembled from the runtime's
 //! sans-IO services (SDO server, NMT slave, heartbeat producer, LSS slave,
 //! a TPDO transmitter) served on a task, and a monitor port that sees
-//! every frame. Compiled on its own it holds no tests.
-#![cfg(feature = "tokio")]
-#![allow(dead_code)]
+//! every frame.
 
 use std::time::Duration;
 
@@ -28,28 +27,7 @@ use tokio::task::JoinHandle;
 pub const DEVICE: u8 = 0x20;
 pub const IDENTITY: Identity = Identity::new(0x0000_02A5, 0x1234, 7, 0xBEEF);
 
-pub fn node(id: u8) -> NodeId {
-    NodeId::new(id).unwrap()
-}
-
-pub fn frame(id: u16, data: &[u8]) -> Frame {
-    Frame::new(CanId::Standard(id), data).unwrap()
-}
-
-macro_rules! entry {
-    ($name:ident, $index:literal, $sub:literal, $ty:ident, $access:ident, $value:ty) => {
-        pub struct $name;
-        impl Entry for $name {
-            const INDEX: u16 = $index;
-            const SUBINDEX: u8 = $sub;
-            const NAME: &'static str = stringify!($name);
-            const DATA_TYPE: DataType = DataType::$ty;
-            const PDO_MAPPABLE: bool = false;
-            type Access = access::$access;
-            type Value = $value;
-        }
-    };
-}
+pub use super::{frame, node};
 
 entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
 entry!(
@@ -62,29 +40,8 @@ entry!(
 );
 entry!(Blob, 0x2100, 0, Domain, Rw, od::bytes::Domain);
 
-/// The device's TPDO1: a 16-bit counter at 0x2001:00.
-#[derive(Debug, PartialEq)]
-pub struct Counter(pub u16);
-
-impl od::Pdo for Counter {
-    const DIRECTION: PdoDirection = PdoDirection::Tpdo;
-    const NUMBER: u16 = 1;
-    const COMMUNICATION_INDEX: u16 = 0x1800;
-    const MAPPING_INDEX: u16 = 0x1A00;
-    const LEN: usize = 2;
-    const MAPPING: &'static [u32] = &[0x2001_0010];
-    fn default_cob_id(node_id: NodeId) -> Option<PdoCobId> {
-        Some(PdoCobId(0x180 + u32::from(node_id.get())))
-    }
-    fn decode(data: &[u8]) -> Result<Self, PdoLengthError> {
-        let bytes = eds2rust_runtime::pdo::layout::load::<2>(data)?;
-        Ok(Counter(u16::from_le_bytes(*bytes)))
-    }
-    fn encode_into(&self, out: &mut [u8; 8]) -> usize {
-        out[..2].copy_from_slice(&self.0.to_le_bytes());
-        2
-    }
-}
+// The device's TPDO1: a 16-bit counter at 0x2001:00.
+word_pdo!(Counter, Tpdo, 0x1800, 0x180, 0x2001_0010);
 
 /// The device: SDO server, NMT slave, heartbeat every 50 ms, LSS slave,
 /// TPDO1 (a counter, sent at every SYNC and counted up after it).
