@@ -152,10 +152,10 @@ impl<R: BufRead> Iterator for Reader<R> {
     type Item = Result<TraceLine, TraceError>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        loop {
-            let (line, bytes) = self.lines.next_line()?;
+        let trc = &mut self.trc;
+        self.lines.next_item(|line, bytes| {
             let parsed = match bytes {
-                Ok(bytes) => parse_bytes(&mut self.trc, bytes),
+                Ok(bytes) => parse_bytes(trc, bytes),
                 Err(LineError::TooLong) => Err(Problem::TooLong),
                 Err(LineError::Io(e)) => {
                     return Some(Err(TraceError {
@@ -166,11 +166,11 @@ impl<R: BufRead> Iterator for Reader<R> {
                 }
             };
             match parsed {
-                Ok(None) => continue,
-                Ok(Some((time, frame))) => return Some(Ok(TraceLine { line, time, frame })),
-                Err(problem) => return Some(Err(problem.into_error(line))),
+                Ok(None) => None,
+                Ok(Some((time, frame))) => Some(Ok(TraceLine { line, time, frame })),
+                Err(problem) => Some(Err(problem.into_error(line))),
             }
-        }
+        })
     }
 }
 

@@ -226,8 +226,7 @@ impl<R: BufRead> Iterator for Reader<R> {
     type Item = Result<LogLine, Error>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        loop {
-            let (line, bytes) = self.lines.next_line()?;
+        self.lines.next_item(|line, bytes| {
             let error = |reason| Some(Err(Error::Parse(ParseError { line, reason })));
             let bytes = match bytes {
                 Ok(bytes) => bytes,
@@ -238,11 +237,10 @@ impl<R: BufRead> Iterator for Reader<R> {
                 return error(Reason::NotUtf8);
             };
             match parse_line(text) {
-                Ok(Some(line)) => return Some(Ok(line)),
-                Ok(None) => continue,
-                Err(reason) => return error(reason),
+                Ok(line) => line.map(Ok),
+                Err(reason) => error(reason),
             }
-        }
+        })
     }
 }
 

@@ -59,6 +59,21 @@ impl<R: BufRead> Lines<R> {
         self.input
     }
 
+    /// The first item `parse` makes of the next lines (given as
+    /// [`Lines::next_line`] gives them; a line it makes nothing of is
+    /// skipped); `None` at the end of the input.
+    pub(crate) fn next_item<T>(
+        &mut self,
+        mut parse: impl FnMut(usize, Result<&[u8], LineError>) -> Option<T>,
+    ) -> Option<T> {
+        loop {
+            let (line, bytes) = self.next_line()?;
+            if let Some(item) = parse(line, bytes) {
+                return Some(item);
+            }
+        }
+    }
+
     /// The next line, its number and its bytes without the line end
     /// (`\n` or `\r\n`); `None` at the end of the input and after a
     /// failure to read (given once, as [`LineError::Io`]).
