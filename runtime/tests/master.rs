@@ -26,7 +26,7 @@ use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};
 use eds2rust_runtime::transport::Clock;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use eds2rust_runtime::{CanId, Frame, Instant, Service};
-use support::node;
+use support::{fire_due, node};
 
 const DEVICE: u8 = 0x20;
 /// The master's heartbeat period.
@@ -89,12 +89,8 @@ impl Service for Device {
         self.heartbeat.set_state(self.nmt.state());
     }
     fn handle_timeout(&mut self, now: Instant) {
-        if self.sdo.poll_timeout().is_some_and(|at| at <= now) {
-            self.sdo.handle_timeout(now);
-        }
-        if self.heartbeat.poll_timeout().is_some_and(|at| at <= now) {
-            self.heartbeat.handle_timeout(now);
-        }
+        fire_due(&mut self.sdo, now);
+        fire_due(&mut self.heartbeat, now);
     }
     fn poll_transmit(&mut self) -> Option<Frame> {
         self.sdo

@@ -23,6 +23,20 @@ use eds2rust_runtime::transport::AsyncBus;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use tokio::time::Instant as TokioInstant;
 
+/// `e` is an SDO timeout.
+fn assert_sdo_timeout(e: &Error) {
+    assert!(
+        matches!(
+            e,
+            Error::Sdo {
+                error: SdoError::Timeout,
+                ..
+            }
+        ),
+        "{e}"
+    );
+}
+
 #[tokio::test(start_paused = true)]
 async fn typed_segmented_and_block_transfers() {
     let rig = Rig::new(|_| {}).await;
@@ -88,12 +102,7 @@ async fn a_cancelled_transfer_is_aborted_and_the_next_succeeds() {
     let mut peer = rig.bus.attach();
     let m = rig.master.clone();
     let read = tokio::spawn(async move { m.upload(node(0x31), 0x1008, 0).await });
-    let request = recv_from(&mut peer, 0x631).await.unwrap();
-    assert_eq!(request.to_string(), "631#4008100000000000");
-    let response = frame(0x5B1, &[0x41, 0x08, 0x10, 0x00, 20, 0, 0, 0]);
-    AsyncBus::send(&mut peer, &response).await.unwrap();
-    let segment = recv_from(&mut peer, 0x631).await.unwrap();
-    assert_eq!(segment.to_string(), "631#6000000000000000");
+    start_segmented_upload(&mut peer).await;
     // The caller gives up mid-transfer.
     tokio::time::sleep(Duration::from_millis(100)).await;
     read.abort();
@@ -134,16 +143,7 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
     let start = TokioInstant::now();
     // No node 0x32 on the bus.
     let e = rig.master.upload(node(0x32), 0x1000, 0).await.unwrap_err();
-    assert!(
-        matches!(
-            e,
-            Error::Sdo {
-                error: SdoError::Timeout,
-                ..
-            }
-        ),
-        "{e}"
-    );
+    assert_sdo_timeout(&e);
     assert_eq!(start.elapsed(), Duration::from_millis(200));
     let aborts: Vec<String> = rig
         .seen()
@@ -154,16 +154,7 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
     assert_eq!(aborts, ["632#4000100000000000", "632#8000100000000405"]);
     // A later call works (and times out the same way).
     let e = rig.master.upload(node(0x32), 0x1000, 0).await.unwrap_err();
-    assert!(
-        matches!(
-            e,
-            Error::Sdo {
-                error: SdoError::Timeout,
-                ..
-            }
-        ),
-        "{e}"
-    );
+    assert_sdo_timeout(&e);
     rig.seen();
     // A future dropped in place (a `timeout` around it) is aborted at once.
     let start = TokioInstant::now();

@@ -161,12 +161,7 @@ async fn a_dropped_streamed_upload_is_aborted_and_the_next_succeeds() {
     // first segment comes, then nothing.
     let mut peer = rig.bus.attach();
     let script = tokio::spawn(async move {
-        let request = recv_from(&mut peer, 0x631).await.unwrap();
-        assert_eq!(request.to_string(), "631#4008100000000000");
-        let response = frame(0x5B1, &[0x41, 0x08, 0x10, 0x00, 20, 0, 0, 0]);
-        AsyncBus::send(&mut peer, &response).await.unwrap();
-        let segment = recv_from(&mut peer, 0x631).await.unwrap();
-        assert_eq!(segment.to_string(), "631#6000000000000000");
+        start_segmented_upload(&mut peer).await;
         let data = frame(0x5B1, &[0x00, b'e', b'd', b's', b'2', b'r', b'u', b's']);
         AsyncBus::send(&mut peer, &data).await.unwrap();
         let next = recv_from(&mut peer, 0x631).await.unwrap();

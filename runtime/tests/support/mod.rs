@@ -5,7 +5,7 @@
 #![allow(dead_code, unused_macros, unused_imports)]
 
 use eds2rust_runtime::od::NodeId;
-use eds2rust_runtime::{CanId, Frame};
+use eds2rust_runtime::{CanId, Frame, Instant, Service};
 
 pub fn node(id: u8) -> NodeId {
     NodeId::new(id).unwrap()
@@ -14,6 +14,14 @@ pub fn node(id: u8) -> NodeId {
 /// A standard data frame.
 pub fn frame(id: u16, data: &[u8]) -> Frame {
     Frame::new(CanId::Standard(id), data).unwrap()
+}
+
+/// Hands `now` to `service` when its timer is due (the devices the tests
+/// assemble from several services fire each one's timer so).
+pub fn fire_due<S: Service + ?Sized>(service: &mut S, now: Instant) {
+    if service.poll_timeout().is_some_and(|at| at <= now) {
+        service.handle_timeout(now);
+    }
 }
 
 /// An object entry as generated code declares it: `entry!(Name, index,

@@ -27,7 +27,7 @@ use tokio::task::JoinHandle;
 pub const DEVICE: u8 = 0x20;
 pub const IDENTITY: Identity = Identity::new(0x0000_02A5, 0x1234, 7, 0xBEEF);
 
-pub use super::{frame, node};
+pub use super::{fire_due, frame, node};
 
 entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
 entry!(
@@ -100,12 +100,8 @@ impl Service for Device {
         }
     }
     fn handle_timeout(&mut self, now: Instant) {
-        if self.sdo.poll_timeout().is_some_and(|at| at <= now) {
-            self.sdo.handle_timeout(now);
-        }
-        if self.heartbeat.poll_timeout().is_some_and(|at| at <= now) {
-            self.heartbeat.handle_timeout(now);
-        }
+        fire_due(&mut self.sdo, now);
+        fire_due(&mut self.heartbeat, now);
     }
     fn poll_transmit(&mut self) -> Option<Frame> {
         self.sdo
@@ -194,6 +190,17 @@ impl Rig {
         .await
         .expect("no such event within 10 s")
     }
+}
+
+/// Plays node 0x31 on `peer`: answers the upload of 0x1008:00 with a
+/// segmented initiate of 20 bytes and takes the first segment request.
+pub async fn start_segmented_upload(peer: &mut VirtualPort) {
+    let request = recv_from(peer, 0x631).await.unwrap();
+    assert_eq!(request.to_string(), "631#4008100000000000");
+    let response = frame(0x5B1, &[0x41, 0x08, 0x10, 0x00, 20, 0, 0, 0]);
+    AsyncBus::send(peer, &response).await.unwrap();
+    let segment = recv_from(peer, 0x631).await.unwrap();
+    assert_eq!(segment.to_string(), "631#6000000000000000");
 }
 
 /// The next frame `port` receives with `cob_id`.
