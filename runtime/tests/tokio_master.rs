@@ -145,12 +145,7 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
     let e = rig.master.upload(node(0x32), 0x1000, 0).await.unwrap_err();
     assert_sdo_timeout(&e);
     assert_eq!(start.elapsed(), Duration::from_millis(200));
-    let aborts: Vec<String> = rig
-        .seen()
-        .iter()
-        .filter(|f| f.standard_id() == Some(0x632))
-        .map(Frame::to_string)
-        .collect();
+    let aborts: Vec<String> = rig.seen_on(0x632);
     assert_eq!(aborts, ["632#4000100000000000", "632#8000100000000405"]);
     // A later call works (and times out the same way).
     let e = rig.master.upload(node(0x32), 0x1000, 0).await.unwrap_err();
@@ -163,12 +158,7 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
     assert!(tokio::time::timeout(cut, upload).await.is_err());
     rig.master.flush().await.unwrap();
     assert_eq!(start.elapsed(), cut);
-    let sent: Vec<String> = rig
-        .seen()
-        .iter()
-        .filter(|f| f.standard_id() == Some(0x632))
-        .map(Frame::to_string)
-        .collect();
+    let sent: Vec<String> = rig.seen_on(0x632);
     assert_eq!(sent, ["632#4018100100000000", "632#8018100100000405"]);
 }
 

@@ -176,6 +176,16 @@ impl Rig {
         std::iter::from_fn(|| self.monitor.try_recv()).collect()
     }
 
+    /// The frames with `cob_id` the monitor saw since the last call (of
+    /// this or [`Rig::seen`]), as text.
+    pub fn seen_on(&self, cob_id: u16) -> Vec<String> {
+        self.seen()
+            .iter()
+            .filter(|f| f.standard_id() == Some(cob_id))
+            .map(Frame::to_string)
+            .collect()
+    }
+
     /// Waits (in virtual time) for the first event `pick` takes.
     pub async fn wait_for<T>(&mut self, mut pick: impl FnMut(&MasterEvent) -> Option<T>) -> T {
         let within = Duration::from_secs(10);
