@@ -9,6 +9,7 @@ use support::tokio_rig::*;
 
 use std::time::Duration;
 
+use eds2rust_runtime::CanId;
 use eds2rust_runtime::emcy::EmcyEvent;
 use eds2rust_runtime::heartbeat::HeartbeatEvent;
 use eds2rust_runtime::lss::{IdentityField, LssState};
@@ -17,7 +18,6 @@ use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState, NmtTarget};
 use eds2rust_runtime::od::PdoLengthError;
 use eds2rust_runtime::pdo::PdoCobId;
 use eds2rust_runtime::sync::SyncProducer;
-use eds2rust_runtime::CanId;
 use tokio::time::Instant as TokioInstant;
 
 #[tokio::test(start_paused = true)]

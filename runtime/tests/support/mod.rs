@@ -4,7 +4,13 @@
 //! ([`tokio_rig`]). Each test file takes it with `#[macro_use] mod support;`.
 #![allow(dead_code, unused_macros, unused_imports)]
 
+use std::time::Duration;
+
+use eds2rust_runtime::heartbeat::HeartbeatProducer;
+use eds2rust_runtime::nmt::NmtSlave;
 use eds2rust_runtime::od::NodeId;
+use eds2rust_runtime::sdo::Channel;
+use eds2rust_runtime::sdo::server::{ObjectStore, SdoServer, ServerConfig};
 use eds2rust_runtime::{CanId, Frame, Instant, Service};
 
 pub fn node(id: u8) -> NodeId {
@@ -21,6 +27,55 @@ pub fn frame(id: u16, data: &[u8]) -> Frame {
 pub fn fire_due<S: Service + ?Sized>(service: &mut S, now: Instant) {
     if service.poll_timeout().is_some_and(|at| at <= now) {
         service.handle_timeout(now);
+    }
+}
+
+/// The core of the devices the master tests serve: an SDO server on
+/// `store` (default channel), an NMT slave, booted, and a heartbeat every
+/// 50 ms that reports the NMT state, started at `now`.
+pub struct BasicDevice<S> {
+    pub sdo: SdoServer<S>,
+    pub nmt: NmtSlave,
+    pub heartbeat: HeartbeatProducer,
+}
+
+impl<S: ObjectStore> BasicDevice<S> {
+    pub fn new(id: NodeId, store: S, now: Instant) -> BasicDevice<S> {
+        let mut device = BasicDevice {
+            sdo: SdoServer::new(ServerConfig::new(Channel::default_for(id)), store),
+            nmt: NmtSlave::new(id),
+            heartbeat: HeartbeatProducer::new(id, Some(Duration::from_millis(50))),
+        };
+        device.nmt.boot_complete();
+        device.heartbeat.set_state(device.nmt.state());
+        device.heartbeat.start(now);
+        device
+    }
+}
+
+impl<S: ObjectStore> Service for BasicDevice<S> {
+    type Event = ();
+    fn handle_frame(&mut self, now: Instant, frame: &Frame) {
+        self.sdo.handle_frame(now, frame);
+        self.nmt.handle_frame(now, frame);
+        while self.nmt.poll_event().is_some() {}
+        self.heartbeat.set_state(self.nmt.state());
+    }
+    fn handle_timeout(&mut self, now: Instant) {
+        fire_due(&mut self.sdo, now);
+        fire_due(&mut self.heartbeat, now);
+    }
+    fn poll_transmit(&mut self) -> Option<Frame> {
+        self.sdo
+            .poll_transmit()
+            .or_else(|| self.heartbeat.poll_transmit())
+    }
+    fn poll_event(&mut self) -> Option<()> {
+        while self.sdo.poll_event().is_some() {}
+        None
+    }
+    fn poll_timeout(&self) -> Option<Instant> {
+        eds2rust_runtime::time::earliest(self.sdo.poll_timeout(), self.heartbeat.poll_timeout())
     }
 }
 

@@ -27,7 +27,7 @@ use tokio::task::JoinHandle;
 pub const DEVICE: u8 = 0x20;
 pub const IDENTITY: Identity = Identity::new(0x0000_02A5, 0x1234, 7, 0xBEEF);
 
-pub use super::{fire_due, frame, node};
+pub use super::{BasicDevice, frame, node};
 
 entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
 entry!(
@@ -46,16 +46,14 @@ word_pdo!(Counter, Tpdo, 0x1800, 0x180, 0x2001_0010);
 /// The device: SDO server, NMT slave, heartbeat every 50 ms, LSS slave,
 /// TPDO1 (a counter, sent at every SYNC and counted up after it).
 pub struct Device {
-    sdo: SdoServer<MemoryStore>,
-    nmt: NmtSlave,
-    heartbeat: HeartbeatProducer,
+    basic: BasicDevice<MemoryStore>,
     lss: LssSlave,
     tpdo: PdoTransmitter,
     counter: u16,
 }
 
 impl Device {
-    fn new() -> Device {
+    fn new(now: Instant) -> Device {
         let id = node(DEVICE);
         let mut store = MemoryStore::new();
         store.insert_fixed(0x1017, 0, AccessRight::Rw, &50u16.to_le_bytes());
@@ -73,9 +71,7 @@ impl Device {
         .unwrap();
         tpdo.set_data(Instant::ZERO, &0u16.to_le_bytes()).unwrap();
         Device {
-            sdo: SdoServer::new(ServerConfig::new(Channel::default_for(id)), store),
-            nmt: NmtSlave::new(id),
-            heartbeat: HeartbeatProducer::new(id, Some(Duration::from_millis(50))),
+            basic: BasicDevice::new(id, store, now),
             lss: LssSlave::new(IDENTITY, Some(id), BitTiming::standard(BitRate::Kbit500)),
             tpdo,
             counter: 0,
@@ -86,10 +82,7 @@ impl Device {
 impl Service for Device {
     type Event = ();
     fn handle_frame(&mut self, now: Instant, frame: &Frame) {
-        self.sdo.handle_frame(now, frame);
-        self.nmt.handle_frame(now, frame);
-        while self.nmt.poll_event().is_some() {}
-        self.heartbeat.set_state(self.nmt.state());
+        self.basic.handle_frame(now, frame);
         self.lss.handle_frame(now, frame);
         while self.lss.poll_event().is_some() {}
         self.tpdo.handle_frame(now, frame);
@@ -100,22 +93,19 @@ impl Service for Device {
         }
     }
     fn handle_timeout(&mut self, now: Instant) {
-        fire_due(&mut self.sdo, now);
-        fire_due(&mut self.heartbeat, now);
+        self.basic.handle_timeout(now);
     }
     fn poll_transmit(&mut self) -> Option<Frame> {
-        self.sdo
+        self.basic
             .poll_transmit()
-            .or_else(|| self.heartbeat.poll_transmit())
             .or_else(|| self.lss.poll_transmit())
             .or_else(|| self.tpdo.poll_transmit())
     }
     fn poll_event(&mut self) -> Option<()> {
-        while self.sdo.poll_event().is_some() {}
-        None
+        self.basic.poll_event()
     }
     fn poll_timeout(&self) -> Option<Instant> {
-        eds2rust_runtime::time::earliest(self.sdo.poll_timeout(), self.heartbeat.poll_timeout())
+        self.basic.poll_timeout()
     }
 }
 
@@ -123,10 +113,7 @@ impl Service for Device {
 pub fn spawn_device(mut port: VirtualPort) -> JoinHandle<()> {
     tokio::spawn(async move {
         let clock = driver::clock();
-        let mut device = Device::new();
-        device.nmt.boot_complete();
-        device.heartbeat.set_state(device.nmt.state());
-        device.heartbeat.start(clock.now());
+        let mut device = Device::new(clock.now());
         let pending = std::future::pending();
         let _ = driver::serve(
             &mut port,
