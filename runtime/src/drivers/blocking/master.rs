@@ -12,6 +12,7 @@ pub(crate) mod lss;
 mod pdo;
 mod sdo;
 
+pub(crate) use drive::DriveEvents;
 pub use drive::{DRIVE_EVENTS_KEPT, DriveHandle};
 pub use lss::LssRequestError;
 

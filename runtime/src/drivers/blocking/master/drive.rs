@@ -152,8 +152,53 @@ impl<B: Bus> Master<B> {
     }
 }
 
+/// Where the events of a drive handle (blocking or tokio) go: to its
+/// observer (`O`, a closure) once one is set, or else into a log of the
+/// newest [`DRIVE_EVENTS_KEPT`].
+pub(crate) struct DriveEvents<O: ?Sized> {
+    observer: Option<Box<O>>,
+    log: VecDeque<(Instant, Event)>,
+}
+
+impl<O: ?Sized + FnMut(Instant, &Event)> DriveEvents<O> {
+    pub(crate) fn new() -> DriveEvents<O> {
+        DriveEvents {
+            observer: None,
+            log: VecDeque::new(),
+        }
+    }
+
+    /// Whether an observer is set.
+    pub(crate) fn observed(&self) -> bool {
+        self.observer.is_some()
+    }
+
+    /// Hands every event from now on to `observer`.
+    pub(crate) fn set_observer(&mut self, observer: Box<O>) {
+        self.observer = Some(observer);
+    }
+
+    /// The events kept since the last call.
+    pub(crate) fn take(&mut self) -> Vec<(Instant, Event)> {
+        self.log.drain(..).collect()
+    }
+
+    /// Hands `event`, seen `at`, to the observer, or else keeps it.
+    pub(crate) fn deliver(&mut self, at: Instant, event: Event) {
+        match &mut self.observer {
+            Some(observer) => observer(at, &event),
+            None => {
+                if self.log.len() >= DRIVE_EVENTS_KEPT {
+                    self.log.pop_front();
+                }
+                self.log.push_back((at, event));
+            }
+        }
+    }
+}
+
 /// The observer of a [`DriveHandle`].
-type Observer<'a> = Box<dyn FnMut(Instant, &Event) + 'a>;
+type Observer<'a> = dyn FnMut(Instant, &Event) + 'a;
 
 /// One CiA 402 drive on a blocking [`Master`] (see [`Master::drive`]).
 ///
@@ -167,8 +212,7 @@ pub struct DriveHandle<'a, B> {
     master: &'a mut Master<B>,
     node: NodeId,
     session: Session,
-    observer: Option<Observer<'a>>,
-    log: VecDeque<(Instant, Event)>,
+    events: DriveEvents<Observer<'a>>,
 }
 
 impl<B> fmt::Debug for DriveHandle<'_, B> {
@@ -176,7 +220,7 @@ impl<B> fmt::Debug for DriveHandle<'_, B> {
         f.debug_struct("DriveHandle")
             .field("node", &self.node)
             .field("session", &self.session)
-            .field("observer", &self.observer.is_some())
+            .field("observer", &self.events.observed())
             .finish_non_exhaustive()
     }
 }
@@ -188,36 +232,26 @@ impl<'a, B: Bus> DriveHandle<'a, B> {
             master,
             node,
             session,
-            observer: None,
-            log: VecDeque::new(),
+            events: DriveEvents::new(),
         }
     }
 
     /// Hands every event from now on to `observer` (with the time it was
     /// seen) instead of keeping it.
     pub fn on_event(&mut self, observer: impl FnMut(Instant, &Event) + 'a) {
-        self.observer = Some(Box::new(observer));
+        self.events.set_observer(Box::new(observer));
     }
 
     /// The events kept since the last call (at most [`DRIVE_EVENTS_KEPT`],
     /// the newest), when no observer is set.
     pub fn take_events(&mut self) -> Vec<(Instant, Event)> {
-        self.log.drain(..).collect()
+        self.events.take()
     }
 
     /// Runs one request (every other call is this one).
     pub fn request(&mut self, request: Request) -> Result<(), Error> {
-        let observer = &mut self.observer;
-        let log = &mut self.log;
-        let mut on_event = |at: Instant, event: Event| match observer {
-            Some(observer) => observer(at, &event),
-            None => {
-                if log.len() >= DRIVE_EVENTS_KEPT {
-                    log.pop_front();
-                }
-                log.push_back((at, event));
-            }
-        };
+        let events = &mut self.events;
+        let mut on_event = |at: Instant, event: Event| events.deliver(at, event);
         self.master
             .run_drive_request(self.node, &mut self.session, request, &mut on_event)
     }

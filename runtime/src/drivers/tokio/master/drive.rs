@@ -11,7 +11,6 @@
 
 use core::fmt;
 use std::boxed::Box;
-use std::collections::VecDeque;
 use std::vec::Vec;
 
 use super::Master;
@@ -24,7 +23,7 @@ use crate::pdo::PdoEvent;
 use crate::tokio::Events;
 use crate::{CanId, Instant};
 
-pub use crate::blocking::DRIVE_EVENTS_KEPT;
+use crate::blocking::master::DriveEvents;
 
 impl Master {
     /// A CiA 402 drive at `node` whose object table is `objects` (a
@@ -160,21 +159,20 @@ impl Drop for CancelOnDrop<'_> {
 }
 
 /// The observer of a [`DriveHandle`].
-type Observer = Box<dyn FnMut(Instant, &Event) + Send>;
+type Observer = dyn FnMut(Instant, &Event) + Send;
 
 /// One CiA 402 drive on the tokio [`Master`] (see [`Master::drive`]): the
 /// async counterpart of [`blocking::DriveHandle`](crate::blocking::DriveHandle),
 /// with the same calls. The drive's [`Event`]s (state changes, faults) go
 /// to the observer ([`DriveHandle::on_event`]) as they happen, or else are
 /// kept for [`DriveHandle::take_events`] (the newest
-/// [`DRIVE_EVENTS_KEPT`]).
+/// [`DRIVE_EVENTS_KEPT`](crate::blocking::DRIVE_EVENTS_KEPT)).
 pub struct DriveHandle {
     master: Master,
     node: NodeId,
     session: Session,
     pdos: Option<Events>,
-    observer: Option<Observer>,
-    log: VecDeque<(Instant, Event)>,
+    events: DriveEvents<Observer>,
 }
 
 impl fmt::Debug for DriveHandle {
@@ -182,7 +180,7 @@ impl fmt::Debug for DriveHandle {
         f.debug_struct("DriveHandle")
             .field("node", &self.node)
             .field("session", &self.session)
-            .field("observer", &self.observer.is_some())
+            .field("observer", &self.events.observed())
             .finish_non_exhaustive()
     }
 }
@@ -198,37 +196,27 @@ impl DriveHandle {
             node,
             session,
             pdos,
-            observer: None,
-            log: VecDeque::new(),
+            events: DriveEvents::new(),
         }
     }
 
     /// Hands every event from now on to `observer` (with the time it was
     /// seen) instead of keeping it.
     pub fn on_event(&mut self, observer: impl FnMut(Instant, &Event) + Send + 'static) {
-        self.observer = Some(Box::new(observer));
+        self.events.set_observer(Box::new(observer));
     }
 
-    /// The events kept since the last call (at most [`DRIVE_EVENTS_KEPT`],
-    /// the newest), each with the time it was seen, when no observer is
-    /// set.
+    /// The events kept since the last call (at most
+    /// [`DRIVE_EVENTS_KEPT`](crate::blocking::DRIVE_EVENTS_KEPT), the
+    /// newest), each with the time it was seen, when no observer is set.
     pub fn take_events(&mut self) -> Vec<(Instant, Event)> {
-        self.log.drain(..).collect()
+        self.events.take()
     }
 
     /// Runs one request (every other call is this one).
     pub async fn request(&mut self, request: Request) -> Result<(), Error> {
-        let observer = &mut self.observer;
-        let log = &mut self.log;
-        let mut on_event = |at: Instant, event: Event| match observer {
-            Some(observer) => observer(at, &event),
-            None => {
-                if log.len() >= DRIVE_EVENTS_KEPT {
-                    log.pop_front();
-                }
-                log.push_back((at, event));
-            }
-        };
+        let events = &mut self.events;
+        let mut on_event = |at: Instant, event: Event| events.deliver(at, event);
         self.master
             .run_drive_request(
                 self.node,
