@@ -12,8 +12,8 @@ pub(crate) mod lss;
 mod pdo;
 mod sdo;
 
-pub(crate) use drive::DriveEvents;
 pub use drive::{DRIVE_EVENTS_KEPT, DriveHandle};
+pub(crate) use drive::{DriveEvents, StatuswordPdo, next_action, statusword_pdo};
 pub use lss::LssRequestError;
 
 use super::{Error, IDLE_WAIT, RunError};

@@ -12,7 +12,6 @@ use std::collections::VecDeque;
 use std::vec::Vec;
 
 use super::Master;
-use crate::Instant;
 use crate::blocking::Error;
 use crate::cia402::session::{Action, OperationError, Read, Request, Session, SessionConfig};
 use crate::cia402::{Event, Move, State, Statusword, object};
@@ -20,6 +19,7 @@ use crate::master::MasterEvent;
 use crate::od::{self, DataType, Entry, NodeId, ObjectInfo};
 use crate::pdo::PdoEvent;
 use crate::transport::Bus;
+use crate::{CanId, Instant};
 
 /// Events a [`DriveHandle`] without observer keeps for
 /// [`DriveHandle::take_events`]; the oldest beyond are dropped.
@@ -107,12 +107,7 @@ impl<B: Bus> Master<B> {
         on_event: &mut dyn FnMut(Instant, Event),
     ) -> Result<(), Error> {
         loop {
-            let now = self.now();
-            let action = session.poll_action(now);
-            while let Some(event) = session.poll_event() {
-                on_event(now, event);
-            }
-            match action {
+            match next_action(session, self.now(), on_event) {
                 Action::Write(write) => {
                     let (index, sub) = (write.index, write.sub);
                     self.download(node, index, sub, &write.value.to_le_bytes())?;
@@ -127,21 +122,12 @@ impl<B: Bus> Master<B> {
                     session.on_error_code(code.map(u16::to_le_bytes).as_ref().map(|c| &c[..]));
                 }
                 Action::Wait(until) => {
-                    let pdo = self.run_until(until, |event| match event {
-                        MasterEvent::Pdo(PdoEvent::Received {
-                            can_id,
-                            data,
-                            len,
-                            at,
-                        }) if session.is_statusword_pdo(*can_id) => {
-                            ControlFlow::Break((*can_id, *data, *len, *at))
-                        }
-                        _ => ControlFlow::Continue(()),
+                    let pdo = self.run_until(until, |event| match statusword_pdo(session, event) {
+                        Some(pdo) => ControlFlow::Break(pdo),
+                        None => ControlFlow::Continue(()),
                     });
                     match pdo {
-                        Ok((can_id, data, len, at)) => {
-                            session.on_pdo(can_id, data.get(..len).unwrap_or(&[]), at);
-                        }
+                        Ok(pdo) => pdo.feed(session),
                         Err(Error::DeadlinePassed) => {}
                         Err(e) => return Err(e),
                     }
@@ -149,6 +135,54 @@ impl<B: Bus> Master<B> {
                 Action::Done(result) => return result.map_err(Error::Cia402),
             }
         }
+    }
+}
+
+/// The session's next action at `now`; the events it has are handed to
+/// `on_event` first.
+pub(crate) fn next_action(
+    session: &mut Session,
+    now: Instant,
+    on_event: &mut dyn FnMut(Instant, Event),
+) -> Action {
+    let action = session.poll_action(now);
+    while let Some(event) = session.poll_event() {
+        on_event(now, event);
+    }
+    action
+}
+
+/// A statusword TPDO the session waits for, as the master received it.
+pub(crate) struct StatuswordPdo {
+    can_id: CanId,
+    data: [u8; 8],
+    len: usize,
+    at: Instant,
+}
+
+impl StatuswordPdo {
+    /// Hands the PDO to `session`.
+    pub(crate) fn feed(&self, session: &mut Session) {
+        let data = self.data.get(..self.len).unwrap_or(&[]);
+        session.on_pdo(self.can_id, data, self.at);
+    }
+}
+
+/// The statusword TPDO of `session` that `event` brings, if it brings one.
+pub(crate) fn statusword_pdo(session: &Session, event: &MasterEvent) -> Option<StatuswordPdo> {
+    match *event {
+        MasterEvent::Pdo(PdoEvent::Received {
+            can_id,
+            data,
+            len,
+            at,
+        }) if session.is_statusword_pdo(can_id) => Some(StatuswordPdo {
+            can_id,
+            data,
+            len,
+            at,
+        }),
+        _ => None,
     }
 }
 

@@ -14,16 +14,14 @@ use std::boxed::Box;
 use std::vec::Vec;
 
 use super::Master;
+use crate::Instant;
 use crate::blocking::Error;
 use crate::cia402::session::{Action, OperationError, Read, Request, Session, SessionConfig};
 use crate::cia402::{Event, Move, State, Statusword, object};
-use crate::master::MasterEvent;
 use crate::od::{NodeId, ObjectInfo};
-use crate::pdo::PdoEvent;
 use crate::tokio::Events;
-use crate::{CanId, Instant};
 
-use crate::blocking::master::DriveEvents;
+use crate::blocking::master::{DriveEvents, StatuswordPdo, next_action, statusword_pdo};
 
 impl Master {
     /// A CiA 402 drive at `node` whose object table is `objects` (a
@@ -85,12 +83,7 @@ impl Master {
         on_event: &mut (dyn FnMut(Instant, Event) + Send),
     ) -> Result<(), Error> {
         loop {
-            let now = self.now();
-            let action = session.poll_action(now);
-            while let Some(event) = session.poll_event() {
-                on_event(now, event);
-            }
-            match action {
+            match next_action(session, self.now(), on_event) {
                 Action::Write(write) => {
                     let (index, sub) = (write.index, write.sub);
                     self.download(node, index, sub, &write.value.to_le_bytes())
@@ -113,9 +106,9 @@ impl Master {
                         Some(events) => {
                             ::tokio::select! {
                                 () = sleep => {}
-                                event = next_statusword_pdo(events, session) => {
-                                    if let Some((can_id, data, len, at)) = event {
-                                        session.on_pdo(can_id, data.get(..len).unwrap_or(&[]), at);
+                                pdo = next_statusword_pdo(events, session) => {
+                                    if let Some(pdo) = pdo {
+                                        pdo.feed(session);
                                     }
                                 }
                             }
@@ -129,19 +122,11 @@ impl Master {
 }
 
 /// The next statusword TPDO on `events` (`None` when the stream ends).
-async fn next_statusword_pdo(
-    events: &mut Events,
-    session: &Session,
-) -> Option<(CanId, [u8; 8], usize, Instant)> {
+async fn next_statusword_pdo(events: &mut Events, session: &Session) -> Option<StatuswordPdo> {
     loop {
-        match events.next().await? {
-            MasterEvent::Pdo(PdoEvent::Received {
-                can_id,
-                data,
-                len,
-                at,
-            }) if session.is_statusword_pdo(can_id) => return Some((can_id, data, len, at)),
-            _ => {}
+        let event = events.next().await?;
+        if let Some(pdo) = statusword_pdo(session, &event) {
+            return Some(pdo);
         }
     }
 }
