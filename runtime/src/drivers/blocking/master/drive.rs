@@ -202,9 +202,19 @@ impl<O: ?Sized + FnMut(Instant, &Event)> DriveEvents<O> {
         }
     }
 
-    /// Whether an observer is set.
-    pub(crate) fn observed(&self) -> bool {
-        self.observer.is_some()
+    /// The `Debug` form of the drive handle of `node` and `session` these
+    /// events belong to (whether it has an observer, not the closure).
+    pub(crate) fn debug_handle(
+        &self,
+        f: &mut fmt::Formatter<'_>,
+        node: NodeId,
+        session: &Session,
+    ) -> fmt::Result {
+        f.debug_struct("DriveHandle")
+            .field("node", &node)
+            .field("session", session)
+            .field("observer", &self.observer.is_some())
+            .finish_non_exhaustive()
     }
 
     /// Hands every event from now on to `observer`.
@@ -251,11 +261,7 @@ pub struct DriveHandle<'a, B> {
 
 impl<B> fmt::Debug for DriveHandle<'_, B> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("DriveHandle")
-            .field("node", &self.node)
-            .field("session", &self.session)
-            .field("observer", &self.events.observed())
-            .finish_non_exhaustive()
+        self.events.debug_handle(f, self.node, &self.session)
     }
 }
 

@@ -162,11 +162,7 @@ pub struct DriveHandle {
 
 impl fmt::Debug for DriveHandle {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("DriveHandle")
-            .field("node", &self.node)
-            .field("session", &self.session)
-            .field("observer", &self.events.observed())
-            .finish_non_exhaustive()
+        self.events.debug_handle(f, self.node, &self.session)
     }
 }
 
