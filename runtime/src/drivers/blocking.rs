@@ -259,9 +259,10 @@ impl<B: Bus> SdoClient<B> {
     }
 
     /// The notes typed reads left since the last call (at most
-    /// [`NOTES_KEPT`](crate::sdo::typed::NOTES_KEPT), the newest): values the server sent longer
-    /// than their data type, of which the leading bytes were taken. Empty
-    /// with [`ClientConfig::strict_lengths`], which refuses them instead.
+    /// [`NOTES_KEPT`](crate::sdo::typed::NOTES_KEPT), the newest): values
+    /// the server sent longer than their data type, of which the leading
+    /// bytes were taken. Empty with [`ClientConfig::strict_lengths`], which
+    /// refuses them instead.
     pub fn take_length_notes(&mut self) -> Vec<LengthNote> {
         self.notes.drain(..).collect()
     }

@@ -261,9 +261,9 @@ impl<B: Bus> Master<B> {
     }
 
     /// The notes typed reads left since the last call (at most
-    /// [`NOTES_KEPT`](crate::sdo::typed::NOTES_KEPT), the newest), with the node: values a server
-    /// sent longer than their data type, of which the leading bytes were
-    /// taken. Empty for nodes whose client has
+    /// [`NOTES_KEPT`](crate::sdo::typed::NOTES_KEPT), the newest), with
+    /// the node: values a server sent longer than their data type, of which
+    /// the leading bytes were taken. Empty for nodes whose client has
     /// [`strict_lengths`](crate::sdo::client::ClientConfig::strict_lengths),
     /// which refuses them instead.
     pub fn take_length_notes(&mut self) -> Vec<(NodeId, LengthNote)> {
