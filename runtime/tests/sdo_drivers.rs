@@ -15,6 +15,7 @@ use eds2rust_runtime::sdo::typed::LengthNote;
 use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use eds2rust_runtime::{CanId, Frame};
+use support::assert_sdo_timeout;
 
 entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
 entry!(
@@ -211,13 +212,7 @@ fn blocking_silent_node_times_out_with_an_abort() {
     let (stop, node) = spawn_node(bus.attach(), 0);
     let mut client = blocking::SdoClient::new(bus.attach(), config(Duration::from_millis(50)));
     let start = std::time::Instant::now();
-    assert!(matches!(
-        client.read::<Silent>(),
-        Err(Error::Sdo {
-            error: SdoError::Timeout,
-            ..
-        })
-    ));
+    assert_sdo_timeout(&client.read::<Silent>().unwrap_err());
     let took = start.elapsed();
     assert!(
         took >= Duration::from_millis(50) && took < Duration::from_secs(2),
@@ -301,13 +296,7 @@ mod tokio_drivers {
         let node = spawn_node(bus.attach(), 7);
         let mut client = SdoClient::new(bus.attach(), config(Duration::from_millis(500)));
         let start = ::tokio::time::Instant::now();
-        assert!(matches!(
-            client.read::<Silent>().await,
-            Err(Error::Sdo {
-                error: SdoError::Timeout,
-                ..
-            })
-        ));
+        assert_sdo_timeout(&client.read::<Silent>().await.unwrap_err());
         let took = start.elapsed();
         assert!(
             took >= Duration::from_millis(500) && took < Duration::from_millis(600),

@@ -23,20 +23,6 @@ use eds2rust_runtime::transport::AsyncBus;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use tokio::time::Instant as TokioInstant;
 
-/// `e` is an SDO timeout.
-fn assert_sdo_timeout(e: &Error) {
-    assert!(
-        matches!(
-            e,
-            Error::Sdo {
-                error: SdoError::Timeout,
-                ..
-            }
-        ),
-        "{e}"
-    );
-}
-
 #[tokio::test(start_paused = true)]
 async fn typed_segmented_and_block_transfers() {
     let rig = Rig::new(|_| {}).await;

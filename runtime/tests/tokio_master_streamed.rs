@@ -211,37 +211,17 @@ fn streamed_futures_are_send() {
     assert_send(&upload);
 }
 
-/// The COB-ID entry of TPDO1 (0x1800:01) as a one-element ARRAY, for the
-/// run-time element calls.
-struct Tpdo1CobId;
-
-impl od::Entry for Tpdo1CobId {
-    const INDEX: u16 = 0x1800;
-    const SUBINDEX: u8 = 1;
-    const NAME: &'static str = "TPDO1 COB-ID";
-    const DATA_TYPE: od::DataType = od::DataType::Unsigned32;
-    const PDO_MAPPABLE: bool = false;
-    type Access = od::access::Rw;
-    type Value = u32;
-}
+// The COB-ID entry of TPDO1 (0x1800:01) as a one-element ARRAY, for the
+// run-time element calls.
+entry!(Tpdo1CobId, 0x1800, 1, Unsigned32, Rw, u32);
 
 impl od::Array for Tpdo1CobId {
     const FIRST: u8 = 1;
     const LAST: u8 = 1;
 }
 
-/// The DOMAIN 0x2100:00 as a one-element ARRAY of bytes.
-struct Blobs;
-
-impl od::Entry for Blobs {
-    const INDEX: u16 = 0x2100;
-    const SUBINDEX: u8 = 0;
-    const NAME: &'static str = "Blobs";
-    const DATA_TYPE: od::DataType = od::DataType::Domain;
-    const PDO_MAPPABLE: bool = false;
-    type Access = od::access::Rw;
-    type Value = od::bytes::Domain;
-}
+// The DOMAIN 0x2100:00 as a one-element ARRAY of bytes.
+entry!(Blobs, 0x2100, 0, Domain, Rw, od::bytes::Domain);
 
 impl od::Array for Blobs {
     const FIRST: u8 = 0;

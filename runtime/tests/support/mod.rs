@@ -6,11 +6,12 @@
 
 use std::time::Duration;
 
+use eds2rust_runtime::blocking::Error;
 use eds2rust_runtime::heartbeat::HeartbeatProducer;
 use eds2rust_runtime::nmt::NmtSlave;
 use eds2rust_runtime::od::NodeId;
-use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::server::{ObjectStore, SdoServer, ServerConfig};
+use eds2rust_runtime::sdo::{Channel, SdoError};
 use eds2rust_runtime::{CanId, Frame, Instant, Service};
 
 pub fn node(id: u8) -> NodeId {
@@ -77,6 +78,20 @@ impl<S: ObjectStore> Service for BasicDevice<S> {
     fn poll_timeout(&self) -> Option<Instant> {
         eds2rust_runtime::time::earliest(self.sdo.poll_timeout(), self.heartbeat.poll_timeout())
     }
+}
+
+/// `e` is an SDO timeout.
+pub fn assert_sdo_timeout(e: &Error) {
+    assert!(
+        matches!(
+            e,
+            Error::Sdo {
+                error: SdoError::Timeout,
+                ..
+            }
+        ),
+        "{e}"
+    );
 }
 
 /// An object entry as generated code declares it: `entry!(Name, index,

@@ -27,7 +27,7 @@ use tokio::task::JoinHandle;
 pub const DEVICE: u8 = 0x20;
 pub const IDENTITY: Identity = Identity::new(0x0000_02A5, 0x1234, 7, 0xBEEF);
 
-pub use super::{BasicDevice, frame, node};
+pub use super::{BasicDevice, assert_sdo_timeout, frame, node};
 
 entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
 entry!(
