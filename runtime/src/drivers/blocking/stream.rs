@@ -10,7 +10,7 @@ use core::time::Duration;
 use std::format;
 use std::io::{self, Read, Write};
 
-use super::{Error, Master, Object, RunError, SdoClient, give_up, run_loop, transfer_end};
+use super::{Error, Master, Object, RunError, SdoClient, Upload, give_up, run_loop, transfer_end};
 use crate::master::{self, MasterEvent};
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::AbortCode;
@@ -249,6 +249,24 @@ pub(crate) fn stream_error<R, W, P>(
 }
 
 impl<R, W: Write, P: FnMut(Progress)> Pump<'_, R, W, P> {
+    /// The end of the pump's transfer of `object` (bounded by `limit`)
+    /// that the driver loop ended with `result`: the bytes fed or written
+    /// ([`Pump::finish`]), or the error; an abort is then left in `core`
+    /// for the caller to send ([`stream_error`]).
+    pub(crate) fn end(
+        &mut self,
+        core: &mut client::SdoClient,
+        result: Result<Result<Upload, Error>, RunError>,
+        object: Object,
+        limit: Option<Duration>,
+    ) -> Result<usize, Error> {
+        match result {
+            Ok(Ok(upload)) => self.finish(&upload.data),
+            Ok(Err(e)) => Err(e),
+            Err(e) => Err(stream_error(core, self, e, object, limit)),
+        }
+    }
+
     /// Ends a transfer that went through: an upload's writer gets the rest
     /// its end event carried and is flushed; the last progress report
     /// says all was done. Returns the bytes fed (download) or written
@@ -381,18 +399,14 @@ impl<B: Bus> SdoClient<B> {
             None,
             &mut hook,
         );
-        match result {
-            Ok(Ok(upload)) => pump.finish(&upload.data),
-            Ok(Err(e)) => Err(e),
-            Err(e) => {
-                let error = stream_error(&mut self.core, &mut pump, e, object, bound);
-                while let Some(frame) = self.core.poll_transmit() {
-                    // Best effort: the abort frame of a failing bus may not go.
-                    let _ = self.bus.send(&frame);
-                }
-                Err(error)
+        let end = pump.end(&mut self.core, result, object, bound);
+        if end.is_err() {
+            while let Some(frame) = self.core.poll_transmit() {
+                // Best effort: the abort frame of a failing bus may not go.
+                let _ = self.bus.send(&frame);
             }
         }
+        end
     }
 }
 
@@ -488,16 +502,12 @@ impl<B: Bus> Master<B> {
             other => Err(other),
         };
         let mut hook = |core: &mut master::Master, now| pump.round(core.sdo_or_default(node), now);
-        match self.wait_with(deadline, &mut until, &mut hook) {
-            Ok(Ok(upload)) => pump.finish(&upload.data),
-            Ok(Err(e)) => Err(e),
-            Err(e) => {
-                let client = self.core_mut().sdo_or_default(node);
-                let error = stream_error(client, &mut pump, e, object, bound);
-                // Best effort: the abort frame of a failing bus may not go.
-                let _ = self.flush();
-                Err(error)
-            }
+        let result = self.wait_with(deadline, &mut until, &mut hook);
+        let end = pump.end(self.core_mut().sdo_or_default(node), result, object, bound);
+        if end.is_err() {
+            // Best effort: the abort frame of a failing bus may not go.
+            let _ = self.flush();
         }
+        end
     }
 }

@@ -9,7 +9,7 @@ use std::io::{Read, Write};
 
 use super::{Error, SdoClient, run_loop};
 use crate::Service;
-use crate::blocking::stream::{Pump, stream_error};
+use crate::blocking::stream::Pump;
 use crate::blocking::transfer_end;
 use crate::od::{self, Entry};
 use crate::sdo::client::{self, Method, Progress};
@@ -123,17 +123,13 @@ impl<B: AsyncBus> SdoClient<B> {
             &mut hook,
         )
         .await;
-        match result {
-            Ok(Ok(upload)) => pump.finish(&upload.data),
-            Ok(Err(e)) => Err(e),
-            Err(e) => {
-                let error = stream_error(&mut self.core, &mut pump, e, object, limit);
-                while let Some(frame) = self.core.poll_transmit() {
-                    // Best effort: the abort frame of a failing bus may not go.
-                    let _ = self.bus.send(&frame).await;
-                }
-                Err(error)
+        let end = pump.end(&mut self.core, result, object, limit);
+        if end.is_err() {
+            while let Some(frame) = self.core.poll_transmit() {
+                // Best effort: the abort frame of a failing bus may not go.
+                let _ = self.bus.send(&frame).await;
             }
         }
+        end
     }
 }
