@@ -7,13 +7,12 @@ use std::collections::vec_deque;
 use std::io;
 use std::vec::Vec;
 
-mod drive;
+pub(crate) mod drive;
 pub(crate) mod lss;
 mod pdo;
 mod sdo;
 
 pub use drive::{DRIVE_EVENTS_KEPT, DriveHandle};
-pub(crate) use drive::{DriveEvents, StatuswordPdo, next_action, statusword_pdo};
 pub use lss::LssRequestError;
 
 use super::{Error, IDLE_WAIT, RunError};

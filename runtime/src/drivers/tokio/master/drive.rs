@@ -21,7 +21,7 @@ use crate::cia402::{Event, Move, State, Statusword, object};
 use crate::od::{NodeId, ObjectInfo};
 use crate::tokio::Events;
 
-use crate::blocking::master::{DriveEvents, StatuswordPdo, next_action, statusword_pdo};
+use crate::blocking::master::drive::{DriveEvents, StatuswordPdo, next_action, statusword_pdo};
 
 impl Master {
     /// A CiA 402 drive at `node` whose object table is `objects` (a
