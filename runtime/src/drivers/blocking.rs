@@ -225,7 +225,8 @@ pub(crate) fn recv_until<B: Bus + ?Sized>(
 
 pub use error::Error;
 pub(crate) use transfer::{
-    Object, Transfer, Upload, channel_node, encode, give_up, transfer_end, visible_string,
+    Object, Transfer, Upload, channel_node, encode, give_up, master_transfer_end, transfer_end,
+    visible_string,
 };
 
 /// A blocking SDO client for one node: each call runs one whole transfer.

@@ -10,8 +10,11 @@ use core::time::Duration;
 use std::format;
 use std::io::{self, Read, Write};
 
-use super::{Error, Master, Object, RunError, SdoClient, Upload, give_up, run_loop, transfer_end};
-use crate::master::{self, MasterEvent};
+use super::{
+    Error, Master, Object, RunError, SdoClient, Upload, give_up, master_transfer_end, run_loop,
+    transfer_end,
+};
+use crate::master;
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::AbortCode;
 use crate::sdo::client::{self, ClientConfig, Method, Progress};
@@ -494,13 +497,7 @@ impl<B: Bus> Master<B> {
         let client = self.core_mut().sdo_or_default(node);
         let bound = pump.plan.start(client, now, object)?;
         let deadline = bound.map(|b| now + b);
-        let mut until = |event| match event {
-            MasterEvent::Sdo(n, e) if n == node => match transfer_end(e.clone(), object) {
-                ControlFlow::Break(result) => Ok(result),
-                ControlFlow::Continue(()) => Err(MasterEvent::Sdo(n, e)),
-            },
-            other => Err(other),
-        };
+        let mut until = |event| master_transfer_end(event, object);
         let mut hook = |core: &mut master::Master, now| pump.round(core.sdo_or_default(node), now);
         let result = self.wait_with(deadline, &mut until, &mut hook);
         let end = pump.end(self.core_mut().sdo_or_default(node), result, object, bound);

@@ -10,6 +10,7 @@ use std::vec::Vec;
 
 use super::{Error, RunError};
 use crate::frame::CanId;
+use crate::master::MasterEvent;
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::client::{self, ClientConfig, ClientEvent, Method};
 use crate::sdo::typed::{self, LengthNote};
@@ -140,6 +141,22 @@ pub(crate) fn transfer_end(
             ControlFlow::Break(Err(object.sdo(error)))
         }
         _ => ControlFlow::Continue(()),
+    }
+}
+
+/// The end of the master's transfer of `object` (of its node) that
+/// `event` brings: `Ok` with the uploaded data or the error, or the event
+/// given back (`Err`) for the master's queue when it is another one.
+pub(crate) fn master_transfer_end(
+    event: MasterEvent,
+    object: Object,
+) -> Result<Result<Upload, Error>, MasterEvent> {
+    match event {
+        MasterEvent::Sdo(n, e) if Some(n) == object.node => match transfer_end(e.clone(), object) {
+            ControlFlow::Break(result) => Ok(result),
+            ControlFlow::Continue(()) => Err(MasterEvent::Sdo(n, e)),
+        },
+        other => Err(other),
     }
 }
 

@@ -1,13 +1,13 @@
 //! The SDO calls of the blocking [`Master`]: raw and typed transfers of
 //! any node, run while the master keeps running.
 
-use core::ops::ControlFlow;
 use std::string::String;
 use std::vec::Vec;
 
 use super::{Error, Master};
-use crate::blocking::{Object, Transfer, Upload, encode, give_up, transfer_end, visible_string};
-use crate::master::MasterEvent;
+use crate::blocking::{
+    Object, Transfer, Upload, encode, give_up, master_transfer_end, visible_string,
+};
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::client::Method;
 use crate::transport::Bus;
@@ -27,12 +27,8 @@ impl<B: Bus> Master<B> {
         let client = self.core.sdo_or_default(node);
         transfer.start(client, now, object)?;
         let limit = transfer.bound(client.config());
-        let result = self.wait(Some(now + limit), &mut |event| match event {
-            MasterEvent::Sdo(n, e) if n == node => match transfer_end(e.clone(), object) {
-                ControlFlow::Break(result) => Ok(result),
-                ControlFlow::Continue(()) => Err(MasterEvent::Sdo(n, e)),
-            },
-            other => Err(other),
+        let result = self.wait(Some(now + limit), &mut |event| {
+            master_transfer_end(event, object)
         });
         match result {
             Ok(result) => result,
