@@ -2,7 +2,7 @@
 //! hand-written object entries and 16-bit PDOs (as generated code would
 //! give them), and, with `tokio`, the rig of the tokio master tests
 //! ([`tokio_rig`]). Each test file takes it with `#[macro_use] mod support;`.
-#![allow(dead_code, unused_macros, unused_imports)]
+#![allow(dead_code, unused_macros)]
 
 use std::time::Duration;
 

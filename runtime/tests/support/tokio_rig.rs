@@ -8,25 +8,22 @@
 
 use std::time::Duration;
 
-use eds2rust_runtime::heartbeat::HeartbeatProducer;
 use eds2rust_runtime::lss::{BitRate, BitTiming, Identity, LssSlave};
 use eds2rust_runtime::master::{self, MasterEvent};
-use eds2rust_runtime::nmt::NmtSlave;
-use eds2rust_runtime::od::{
-    self, AccessRight, DataType, Entry, NodeId, PdoDirection, PdoLengthError, access,
-};
+use eds2rust_runtime::od::{self, AccessRight};
 use eds2rust_runtime::pdo::{PdoCobId, PdoTransmitter, TransmissionType, TransmitterConfig};
-use eds2rust_runtime::sdo::Channel;
-use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
+use eds2rust_runtime::sdo::server::MemoryStore;
 use eds2rust_runtime::tokio::{self as driver, Deadline, Events, Master};
 use eds2rust_runtime::transport::AsyncBus;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
-use eds2rust_runtime::{CanId, Frame, Instant, Service};
+use eds2rust_runtime::{Frame, Instant, Service};
 use tokio::task::JoinHandle;
 
 pub const DEVICE: u8 = 0x20;
 pub const IDENTITY: Identity = Identity::new(0x0000_02A5, 0x1234, 7, 0xBEEF);
 
+// What the tests take with `tokio_rig::*`; each uses some of it.
+#[allow(unused_imports)]
 pub use super::{BasicDevice, assert_sdo_timeout, frame, node};
 
 entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
