@@ -51,7 +51,7 @@ pub fn replay(crate_dir: &Path, target: &str, body: fn(&[u8])) {
 /// `fuzz/corpus/<name>` of the calling crate through `body` in a test
 /// named `<name>_corpus`.
 ///
-/// ```ignore
+/// ```text
 /// eds2rust_fuzz_replay::replay_tests! {
 ///     sdo_request_corpus: "sdo_request" => fuzz_checks::sdo_request,
 /// }
