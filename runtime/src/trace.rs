@@ -34,16 +34,20 @@
 use core::fmt;
 use core::time::Duration;
 use std::format;
-use std::io::{self, BufRead};
+use std::io::BufRead;
 use std::string::{String, ToString};
-use std::vec::Vec;
 
 use crate::Frame;
 use candump::MAX_LINE_LEN;
+use lines::{LineError, Lines};
 
 pub mod candump;
+mod hex;
+mod lines;
 pub mod trc;
 
+#[cfg(test)]
+mod test_support;
 #[cfg(test)]
 mod tests;
 
@@ -104,11 +108,8 @@ impl std::error::Error for TraceError {}
 /// `Result<TraceLine, TraceError>`.
 #[derive(Debug)]
 pub struct Reader<R> {
-    input: R,
-    line: usize,
-    buf: Vec<u8>,
+    lines: Lines<R>,
     trc: trc::Parser,
-    failed: bool,
 }
 
 /// A reader of an in-memory trace.
@@ -120,17 +121,14 @@ impl<R: BufRead> Reader<R> {
     /// A reader of `input`, starting at line 1.
     pub fn new(input: R) -> Reader<R> {
         Reader {
-            input,
-            line: 0,
-            buf: Vec::with_capacity(128),
+            lines: Lines::new(input, 128),
             trc: trc::Parser::new(),
-            failed: false,
         }
     }
 
     /// The number of the last line read (1-based; 0 before the first).
     pub fn line_number(&self) -> usize {
-        self.line
+        self.lines.number()
     }
 
     /// The `.trc` version of the last `$FILEVERSION` header, if any.
@@ -146,15 +144,7 @@ impl<R: BufRead> Reader<R> {
 
     /// Gives the input back.
     pub fn into_inner(self) -> R {
-        self.input
-    }
-
-    /// Reads the next line into `buf`; `false` at the end of the input
-    /// (the candump reader's rule for over-long lines).
-    fn read_line(&mut self) -> io::Result<bool> {
-        let more = candump::read_bounded_line(&mut self.input, &mut self.buf)?;
-        self.line += usize::from(more);
-        Ok(more)
+        self.lines.into_inner()
     }
 }
 
@@ -162,29 +152,25 @@ impl<R: BufRead> Iterator for Reader<R> {
     type Item = Result<TraceLine, TraceError>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        loop {
-            if self.failed {
-                return None;
-            }
-            match self.read_line() {
-                Ok(false) => return None,
-                Ok(true) => {}
-                Err(e) => {
-                    self.failed = true;
+        let trc = &mut self.trc;
+        self.lines.next_item(|line, bytes| {
+            let parsed = match bytes {
+                Ok(bytes) => parse_bytes(trc, bytes),
+                Err(LineError::TooLong) => Err(Problem::TooLong),
+                Err(LineError::Io(e)) => {
                     return Some(Err(TraceError {
-                        line: self.line + 1,
+                        line,
                         kind: ErrorKind::Io,
                         message: format!("reading the trace failed: {e}"),
                     }));
                 }
+            };
+            match parsed {
+                Ok(None) => None,
+                Ok(Some((time, frame))) => Some(Ok(TraceLine { line, time, frame })),
+                Err(problem) => Some(Err(problem.into_error(line))),
             }
-            let line = self.line;
-            match parse_bytes(&mut self.trc, &self.buf) {
-                Ok(None) => continue,
-                Ok(Some((time, frame))) => return Some(Ok(TraceLine { line, time, frame })),
-                Err(problem) => return Some(Err(problem.into_error(line))),
-            }
-        }
+        })
     }
 }
 
@@ -225,16 +211,12 @@ impl Problem {
     }
 }
 
-/// One raw line (line end included or not) in any form.
+/// One line (without its line end, at most [`MAX_LINE_LEN`] bytes) in
+/// any form.
 fn parse_bytes(
     trc: &mut trc::Parser,
-    raw: &[u8],
+    bytes: &[u8],
 ) -> Result<Option<(Option<Duration>, Frame)>, Problem> {
-    let bytes = raw.strip_suffix(b"\n").unwrap_or(raw);
-    let bytes = bytes.strip_suffix(b"\r").unwrap_or(bytes);
-    if bytes.len() > MAX_LINE_LEN {
-        return Err(Problem::TooLong);
-    }
     let Ok(text) = core::str::from_utf8(bytes) else {
         // A comment is skipped whatever its encoding (PEAK writes 8-bit
         // text, file names in comments may be Latin-1); a directive is not.

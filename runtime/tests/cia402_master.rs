@@ -278,14 +278,7 @@ fn homing_and_cyclic_synchronous_position() {
     let kinds: Vec<Event> = drive.take_events().into_iter().map(|(_, e)| e).collect();
     assert!(kinds.contains(&Event::HomingAttained));
     drop(drive);
-    let sim = rig.sim();
-    assert_eq!(sim.homing_method, 35);
-    assert_eq!(sim.position, 0);
-    assert_eq!(sim.csp_targets, [10, 20, 30]);
-    assert_eq!(
-        sim.device.mode(),
-        ModeOfOperation::CyclicSynchronousPosition
-    );
+    rig.sim().assert_homed_then_csp(35, [10, 20, 30]);
 }
 
 #[test]

@@ -3,6 +3,9 @@
 //! are taken at the clock's time then, and a peer behind the bus itself
 //! answers after a delay in the clock's time.
 
+#[macro_use]
+mod support;
+
 use std::collections::VecDeque;
 use std::io;
 use std::ops::ControlFlow;
@@ -11,32 +14,20 @@ use std::time::Duration;
 use eds2rust_runtime::blocking::Master;
 use eds2rust_runtime::heartbeat::HeartbeatEvent;
 use eds2rust_runtime::master::{self, MasterEvent};
-use eds2rust_runtime::od::{AccessRight, DataType, Entry, NodeId, access};
+use eds2rust_runtime::od::AccessRight;
 use eds2rust_runtime::sdo::Channel;
 use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use eds2rust_runtime::transport::{Bus, Clock, ManualClock};
 use eds2rust_runtime::{CanId, Frame, Instant, Service};
+use support::node;
 
 /// The master's heartbeat period.
 const PERIOD: Duration = Duration::from_millis(20);
 /// The node the master supervises.
 const DEVICE: u8 = 0x20;
 
-fn node(id: u8) -> NodeId {
-    NodeId::new(id).unwrap()
-}
-
-struct DeviceType;
-impl Entry for DeviceType {
-    const INDEX: u16 = 0x1000;
-    const SUBINDEX: u8 = 0;
-    const NAME: &'static str = "Device type";
-    const DATA_TYPE: DataType = DataType::Unsigned32;
-    const PDO_MAPPABLE: bool = false;
-    type Access = access::Ro;
-    type Value = u32;
-}
+entry!(DeviceType, 0x1000, 0, Unsigned32, Ro, u32);
 
 /// A started master (node 1) on a manual clock, supervising node 0x20's
 /// heartbeat with a consumer time of 100 ms; a port for the test's peer

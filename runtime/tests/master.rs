@@ -3,6 +3,9 @@
 //! (node 0x20) served in a thread, with a monitor port recording every
 //! frame and when it was seen.
 
+#[macro_use]
+mod support;
+
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex, mpsc};
@@ -11,18 +14,19 @@ use std::time::{Duration, Instant as StdInstant};
 
 use eds2rust_runtime::blocking::{self, Error, Master};
 use eds2rust_runtime::emcy::EmcyEvent;
-use eds2rust_runtime::heartbeat::{HeartbeatEvent, HeartbeatProducer};
+use eds2rust_runtime::heartbeat::HeartbeatEvent;
 use eds2rust_runtime::lss::LssState;
 use eds2rust_runtime::master::{self, MasterEvent};
-use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtSlave, NmtState};
-use eds2rust_runtime::od::{AccessRight, DataType, Entry, NodeId, PdoDirection, access};
+use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState};
+use eds2rust_runtime::od::{AccessRight, PdoDirection};
 use eds2rust_runtime::pdo::{PdoCobId, PdoConfig, PdoEvent, TransmissionType};
 use eds2rust_runtime::sdo::client::Method;
-use eds2rust_runtime::sdo::server::{MemoryStore, ObjectStore, SdoServer, ServerConfig};
-use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};
+use eds2rust_runtime::sdo::server::{MemoryStore, ObjectStore};
+use eds2rust_runtime::sdo::{AbortCode, SdoError};
 use eds2rust_runtime::transport::Clock;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
-use eds2rust_runtime::{CanId, Frame, Instant, Service};
+use eds2rust_runtime::{CanId, Frame, Instant};
+use support::{BasicDevice, node};
 
 const DEVICE: u8 = 0x20;
 /// The master's heartbeat period.
@@ -30,42 +34,18 @@ const PERIOD: Duration = Duration::from_millis(20);
 /// How long the device takes to read its slow object unless released.
 const SLOW: Duration = Duration::from_millis(300);
 
-fn node(id: u8) -> NodeId {
-    NodeId::new(id).unwrap()
-}
+entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
 
-struct ProducerHeartbeatTime;
-impl Entry for ProducerHeartbeatTime {
-    const INDEX: u16 = 0x1017;
-    const SUBINDEX: u8 = 0;
-    const NAME: &'static str = "Producer heartbeat time";
-    const DATA_TYPE: DataType = DataType::Unsigned16;
-    const PDO_MAPPABLE: bool = false;
-    type Access = access::Rw;
-    type Value = u16;
-}
+entry!(SlowValue, 0x2000, 1, Unsigned32, Ro, u32);
 
-struct SlowValue;
-impl Entry for SlowValue {
-    const INDEX: u16 = 0x2000;
-    const SUBINDEX: u8 = 1;
-    const NAME: &'static str = "Slow value";
-    const DATA_TYPE: DataType = DataType::Unsigned32;
-    const PDO_MAPPABLE: bool = false;
-    type Access = access::Ro;
-    type Value = u32;
-}
-
-struct Blob;
-impl Entry for Blob {
-    const INDEX: u16 = 0x2100;
-    const SUBINDEX: u8 = 0;
-    const NAME: &'static str = "Blob";
-    const DATA_TYPE: DataType = DataType::Domain;
-    const PDO_MAPPABLE: bool = false;
-    type Access = access::Rw;
-    type Value = eds2rust_runtime::od::bytes::Domain;
-}
+entry!(
+    Blob,
+    0x2100,
+    0,
+    Domain,
+    Rw,
+    eds2rust_runtime::od::bytes::Domain
+);
 
 /// A memory store whose object 0x2000:01 takes [`SLOW`] to read, or less
 /// when released: it tells `started` when the read begins, then answers
@@ -89,44 +69,6 @@ impl ObjectStore for SlowStore {
     }
     fn write(&mut self, index: u16, sub: u8, data: &[u8]) -> Result<(), AbortCode> {
         self.store.write(index, sub, data)
-    }
-}
-
-/// The device: SDO server, NMT slave, and a heartbeat that reports the NMT
-/// state every 50 ms.
-struct Device {
-    sdo: SdoServer<SlowStore>,
-    nmt: NmtSlave,
-    heartbeat: HeartbeatProducer,
-}
-
-impl Service for Device {
-    type Event = ();
-    fn handle_frame(&mut self, now: Instant, frame: &Frame) {
-        self.sdo.handle_frame(now, frame);
-        self.nmt.handle_frame(now, frame);
-        while self.nmt.poll_event().is_some() {}
-        self.heartbeat.set_state(self.nmt.state());
-    }
-    fn handle_timeout(&mut self, now: Instant) {
-        if self.sdo.poll_timeout().is_some_and(|at| at <= now) {
-            self.sdo.handle_timeout(now);
-        }
-        if self.heartbeat.poll_timeout().is_some_and(|at| at <= now) {
-            self.heartbeat.handle_timeout(now);
-        }
-    }
-    fn poll_transmit(&mut self) -> Option<Frame> {
-        self.sdo
-            .poll_transmit()
-            .or_else(|| self.heartbeat.poll_transmit())
-    }
-    fn poll_event(&mut self) -> Option<()> {
-        while self.sdo.poll_event().is_some() {}
-        None
-    }
-    fn poll_timeout(&self) -> Option<Instant> {
-        eds2rust_runtime::time::earliest(self.sdo.poll_timeout(), self.heartbeat.poll_timeout())
     }
 }
 
@@ -177,23 +119,13 @@ impl Rig {
             store.insert_fixed(0x1A00, 0, AccessRight::Rw, &[0]);
             store.insert_fixed(0x1A00, 1, AccessRight::Rw, &[0; 4]);
             store.insert(0x2100, 0, AccessRight::Rw, &[]);
-            let id = node(DEVICE);
-            let mut device = Device {
-                sdo: SdoServer::new(
-                    ServerConfig::new(Channel::default_for(id)),
-                    SlowStore {
-                        store,
-                        started,
-                        release,
-                    },
-                ),
-                nmt: NmtSlave::new(id),
-                heartbeat: HeartbeatProducer::new(id, Some(Duration::from_millis(50))),
-            };
             let clock = Clock::new();
-            device.nmt.boot_complete();
-            device.heartbeat.set_state(device.nmt.state());
-            device.heartbeat.start(clock.now());
+            let slow = SlowStore {
+                store,
+                started,
+                release,
+            };
+            let mut device = BasicDevice::new(node(DEVICE), slow, clock.now());
             blocking::serve(&mut port, &clock, &mut device, &halt, None, |()| {}).unwrap();
         }));
 

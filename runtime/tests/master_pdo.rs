@@ -2,6 +2,9 @@
 //! typed RPDO, `next_pdo` and `latest_pdo` receive typed TPDOs. The device
 //! side is a port the test drives itself.
 
+#[macro_use]
+mod support;
+
 use std::time::Duration;
 
 use eds2rust_runtime::blocking::{Error, Master};
@@ -11,43 +14,12 @@ use eds2rust_runtime::pdo::{PdoCobId, PdoError, PdoEvent, TransmissionType, Tran
 use eds2rust_runtime::sync::SyncProducer;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use eds2rust_runtime::{CanId, Frame};
+use support::node;
 
 const DEVICE: u8 = 0x20;
 
-fn node(id: u8) -> NodeId {
-    NodeId::new(id).unwrap()
-}
-
-/// A 16-bit PDO on the predefined connection set: RPDO1 or TPDO1.
-macro_rules! word_pdo {
-    ($name:ident, $direction:ident, $comm:literal, $base:literal) => {
-        #[derive(Debug, PartialEq)]
-        struct $name(u16);
-
-        impl od::Pdo for $name {
-            const DIRECTION: PdoDirection = PdoDirection::$direction;
-            const NUMBER: u16 = 1;
-            const COMMUNICATION_INDEX: u16 = $comm;
-            const MAPPING_INDEX: u16 = $comm + 0x200;
-            const LEN: usize = 2;
-            const MAPPING: &'static [u32] = &[0x2001_0010];
-            fn default_cob_id(node_id: NodeId) -> Option<PdoCobId> {
-                Some(PdoCobId($base + u32::from(node_id.get())))
-            }
-            fn decode(data: &[u8]) -> Result<Self, PdoLengthError> {
-                let bytes = eds2rust_runtime::pdo::layout::load::<2>(data)?;
-                Ok($name(u16::from_le_bytes(*bytes)))
-            }
-            fn encode_into(&self, out: &mut [u8; 8]) -> usize {
-                out[..2].copy_from_slice(&self.0.to_le_bytes());
-                2
-            }
-        }
-    };
-}
-
-word_pdo!(Command, Rpdo, 0x1400, 0x200);
-word_pdo!(Status, Tpdo, 0x1800, 0x180);
+word_pdo!(Command, Rpdo, 0x1400, 0x200, 0x2001_0010);
+word_pdo!(Status, Tpdo, 0x1800, 0x180, 0x2001_0010);
 
 /// A PDO above the fourth: no default COB-ID.
 struct Fifth;

@@ -1,32 +1,21 @@
 //! The blocking and tokio SDO drivers over the virtual bus, against a fake
 //! node that answers with hand-written CiA 301 frames (no SDO server core).
 
+#[macro_use]
+mod support;
+
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
 use eds2rust_runtime::blocking::{self, Error};
-use eds2rust_runtime::od::{DataType, Entry, ValueError, access, bytes};
+use eds2rust_runtime::od::{DataType, ValueError, bytes};
 use eds2rust_runtime::sdo::client::ClientConfig;
 use eds2rust_runtime::sdo::typed::LengthNote;
 use eds2rust_runtime::sdo::{AbortCode, Channel, SdoError};
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
 use eds2rust_runtime::{CanId, Frame};
-
-macro_rules! entry {
-    ($name:ident, $index:literal, $sub:literal, $ty:ident, $access:ident, $value:ty) => {
-        struct $name;
-        impl Entry for $name {
-            const INDEX: u16 = $index;
-            const SUBINDEX: u8 = $sub;
-            const NAME: &'static str = stringify!($name);
-            const DATA_TYPE: DataType = DataType::$ty;
-            const PDO_MAPPABLE: bool = false;
-            type Access = access::$access;
-            type Value = $value;
-        }
-    };
-}
+use support::assert_sdo_timeout;
 
 entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
 entry!(
@@ -223,13 +212,7 @@ fn blocking_silent_node_times_out_with_an_abort() {
     let (stop, node) = spawn_node(bus.attach(), 0);
     let mut client = blocking::SdoClient::new(bus.attach(), config(Duration::from_millis(50)));
     let start = std::time::Instant::now();
-    assert!(matches!(
-        client.read::<Silent>(),
-        Err(Error::Sdo {
-            error: SdoError::Timeout,
-            ..
-        })
-    ));
+    assert_sdo_timeout(&client.read::<Silent>().unwrap_err());
     let took = start.elapsed();
     assert!(
         took >= Duration::from_millis(50) && took < Duration::from_secs(2),
@@ -313,13 +296,7 @@ mod tokio_drivers {
         let node = spawn_node(bus.attach(), 7);
         let mut client = SdoClient::new(bus.attach(), config(Duration::from_millis(500)));
         let start = ::tokio::time::Instant::now();
-        assert!(matches!(
-            client.read::<Silent>().await,
-            Err(Error::Sdo {
-                error: SdoError::Timeout,
-                ..
-            })
-        ));
+        assert_sdo_timeout(&client.read::<Silent>().await.unwrap_err());
         let took = start.elapsed();
         assert!(
             took >= Duration::from_millis(500) && took < Duration::from_millis(600),

@@ -12,6 +12,7 @@
 
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::thread::JoinHandle;
 use std::time::{Duration, Instant};
 
 use eds2rust_runtime::blocking::{self, SdoClient};
@@ -66,6 +67,29 @@ fn open(name: &str) -> SocketCanBus {
 /// Reads and drops whatever a socket received before its filter was set.
 fn drain(bus: &mut SocketCanBus) {
     while bus.recv(Duration::ZERO).unwrap().is_some() {}
+}
+
+/// Serves `server` on `bus` in a thread for at most a minute, until the
+/// flag it returns is set; the thread gives the server's store back.
+fn spawn_server(
+    mut bus: SocketCanBus,
+    mut server: SdoServer<MemoryStore>,
+) -> (Arc<AtomicBool>, JoinHandle<std::io::Result<MemoryStore>>) {
+    let stop = Arc::new(AtomicBool::new(false));
+    let server_stop = Arc::clone(&stop);
+    let thread = std::thread::spawn(move || {
+        let deadline = Instant::now() + Duration::from_secs(60);
+        blocking::serve(
+            &mut bus,
+            &Clock::new(),
+            &mut server,
+            &server_stop,
+            Some(deadline),
+            |_| {},
+        )
+        .map(|()| server.into_store())
+    });
+    (stop, thread)
 }
 
 fn std_frame(id: u16, data: &[u8]) -> Frame {
@@ -219,22 +243,8 @@ fn sdo_transfers_between_client_and_served_server() {
     let server_bus = open(&name).set_id_filters(&[channel.request]).unwrap();
     let client_bus = open(&name).set_id_filters(&[channel.response]).unwrap();
 
-    let stop = Arc::new(AtomicBool::new(false));
-    let server_stop = Arc::clone(&stop);
-    let server = std::thread::spawn(move || {
-        let mut bus = server_bus;
-        let mut server = SdoServer::new(ServerConfig::new(channel), store);
-        let deadline = Instant::now() + Duration::from_secs(60);
-        blocking::serve(
-            &mut bus,
-            &Clock::new(),
-            &mut server,
-            &server_stop,
-            Some(deadline),
-            |_| {},
-        )
-        .map(|()| server.into_store())
-    });
+    let server = SdoServer::new(ServerConfig::new(channel), store);
+    let (stop, server) = spawn_server(server_bus, server);
 
     let mut client = SdoClient::new(client_bus, ClientConfig::new(channel));
     let results = (|| -> Result<(), blocking::Error> {
@@ -315,23 +325,9 @@ fn sdo_on_an_additional_29_bit_channel() {
     let client_bus = open(&name).set_id_filters(&[extended.response]).unwrap();
     let default_bus = open(&name).set_id_filters(&[default.response]).unwrap();
 
-    let stop = Arc::new(AtomicBool::new(false));
-    let server_stop = Arc::clone(&stop);
-    let server = std::thread::spawn(move || {
-        let mut bus = server_bus;
-        let mut server = SdoServer::new(ServerConfig::new(default), store);
-        server.set_extra_channels(vec![extended]);
-        let deadline = Instant::now() + Duration::from_secs(60);
-        blocking::serve(
-            &mut bus,
-            &Clock::new(),
-            &mut server,
-            &server_stop,
-            Some(deadline),
-            |_| {},
-        )
-        .map(|()| server.into_store())
-    });
+    let mut server = SdoServer::new(ServerConfig::new(default), store);
+    server.set_extra_channels(vec![extended]);
+    let (stop, server) = spawn_server(server_bus, server);
 
     let mut client = SdoClient::new(client_bus, ClientConfig::new(extended));
     let mut default_client = SdoClient::new(default_bus, ClientConfig::new(default));

@@ -229,15 +229,9 @@ async fn homing_then_cyclic_synchronous_position_every_period() {
     let kinds: Vec<Event> = drive.take_events().into_iter().map(|(_, e)| e).collect();
     assert!(kinds.contains(&Event::HomingAttained));
     drop(drive);
-    {
-        let sim = rig.sim.lock().unwrap();
-        assert_eq!(sim.homing_method, 35);
-        assert_eq!(sim.position, 0);
-        assert_eq!(sim.csp_targets, [10, 20, 30]);
-        assert_eq!(
-            sim.device.mode(),
-            ModeOfOperation::CyclicSynchronousPosition
-        );
-    }
+    rig.sim
+        .lock()
+        .unwrap()
+        .assert_homed_then_csp(35, [10, 20, 30]);
     rig.stop().await;
 }

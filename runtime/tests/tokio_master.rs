@@ -2,10 +2,10 @@
 //! cancellation and timeouts, PDO configuration, the driver's lifetime.
 #![cfg(feature = "tokio")]
 
-#[path = "tokio_master_rig.rs"]
-mod rig;
+#[macro_use]
+mod support;
 
-use rig::*;
+use support::tokio_rig::*;
 
 use std::time::Duration;
 
@@ -88,12 +88,7 @@ async fn a_cancelled_transfer_is_aborted_and_the_next_succeeds() {
     let mut peer = rig.bus.attach();
     let m = rig.master.clone();
     let read = tokio::spawn(async move { m.upload(node(0x31), 0x1008, 0).await });
-    let request = recv_from(&mut peer, 0x631).await.unwrap();
-    assert_eq!(request.to_string(), "631#4008100000000000");
-    let response = frame(0x5B1, &[0x41, 0x08, 0x10, 0x00, 20, 0, 0, 0]);
-    AsyncBus::send(&mut peer, &response).await.unwrap();
-    let segment = recv_from(&mut peer, 0x631).await.unwrap();
-    assert_eq!(segment.to_string(), "631#6000000000000000");
+    start_segmented_upload(&mut peer).await;
     // The caller gives up mid-transfer.
     tokio::time::sleep(Duration::from_millis(100)).await;
     read.abort();
@@ -134,36 +129,13 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
     let start = TokioInstant::now();
     // No node 0x32 on the bus.
     let e = rig.master.upload(node(0x32), 0x1000, 0).await.unwrap_err();
-    assert!(
-        matches!(
-            e,
-            Error::Sdo {
-                error: SdoError::Timeout,
-                ..
-            }
-        ),
-        "{e}"
-    );
+    assert_sdo_timeout(&e);
     assert_eq!(start.elapsed(), Duration::from_millis(200));
-    let aborts: Vec<String> = rig
-        .seen()
-        .iter()
-        .filter(|f| f.standard_id() == Some(0x632))
-        .map(Frame::to_string)
-        .collect();
+    let aborts: Vec<String> = rig.seen_on(0x632);
     assert_eq!(aborts, ["632#4000100000000000", "632#8000100000000405"]);
     // A later call works (and times out the same way).
     let e = rig.master.upload(node(0x32), 0x1000, 0).await.unwrap_err();
-    assert!(
-        matches!(
-            e,
-            Error::Sdo {
-                error: SdoError::Timeout,
-                ..
-            }
-        ),
-        "{e}"
-    );
+    assert_sdo_timeout(&e);
     rig.seen();
     // A future dropped in place (a `timeout` around it) is aborted at once.
     let start = TokioInstant::now();
@@ -172,12 +144,7 @@ async fn a_transfer_past_its_bound_times_out_cleanly() {
     assert!(tokio::time::timeout(cut, upload).await.is_err());
     rig.master.flush().await.unwrap();
     assert_eq!(start.elapsed(), cut);
-    let sent: Vec<String> = rig
-        .seen()
-        .iter()
-        .filter(|f| f.standard_id() == Some(0x632))
-        .map(Frame::to_string)
-        .collect();
+    let sent: Vec<String> = rig.seen_on(0x632);
     assert_eq!(sent, ["632#4018100100000000", "632#8018100100000405"]);
 }
 

@@ -2,13 +2,14 @@
 //! streams, their bounded queues, and LSS.
 #![cfg(feature = "tokio")]
 
-#[path = "tokio_master_rig.rs"]
-mod rig;
+#[macro_use]
+mod support;
 
-use rig::*;
+use support::tokio_rig::*;
 
 use std::time::Duration;
 
+use eds2rust_runtime::CanId;
 use eds2rust_runtime::emcy::EmcyEvent;
 use eds2rust_runtime::heartbeat::HeartbeatEvent;
 use eds2rust_runtime::lss::{IdentityField, LssState};
@@ -17,7 +18,6 @@ use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState, NmtTarget};
 use eds2rust_runtime::od::PdoLengthError;
 use eds2rust_runtime::pdo::PdoCobId;
 use eds2rust_runtime::sync::SyncProducer;
-use eds2rust_runtime::{CanId, Frame};
 use tokio::time::Instant as TokioInstant;
 
 #[tokio::test(start_paused = true)]
@@ -71,12 +71,7 @@ async fn emcy_and_nmt_events_and_command_frames() {
         .await
         .unwrap();
     tokio::time::sleep(Duration::from_millis(1)).await;
-    let nmt: Vec<String> = rig
-        .seen()
-        .iter()
-        .filter(|f| f.standard_id() == Some(0x000))
-        .map(Frame::to_string)
-        .collect();
+    let nmt: Vec<String> = rig.seen_on(0x000);
     // CiA 301: start remote node 0x20, reset all nodes.
     assert_eq!(nmt, ["000#0120", "000#8100"]);
 
@@ -184,12 +179,7 @@ async fn lss_switch_and_inquire() {
         ),
         "{e}"
     );
-    let lss: Vec<String> = rig
-        .seen()
-        .iter()
-        .filter(|f| f.standard_id() == Some(0x7E5))
-        .map(Frame::to_string)
-        .collect();
+    let lss: Vec<String> = rig.seen_on(0x7E5);
     // CiA 305: switch state global (0x04) configuration, inquire vendor
     // id (0x5A), serial (0x5D), node id (0x5E).
     assert_eq!(lss[0], "7E5#0401000000000000");

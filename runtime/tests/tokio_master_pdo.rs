@@ -2,43 +2,21 @@
 //! clock: the same names and arguments as the blocking master's.
 #![cfg(feature = "tokio")]
 
-#[path = "tokio_master_rig.rs"]
-mod rig;
+#[macro_use]
+mod support;
 
-use rig::*;
+use support::tokio_rig::*;
 
 use std::time::Duration;
 
 use eds2rust_runtime::CanId;
 use eds2rust_runtime::blocking::Error;
-use eds2rust_runtime::od::{self, NodeId, PdoDirection, PdoLengthError};
 use eds2rust_runtime::pdo::{PdoCobId, PdoError};
 use eds2rust_runtime::sync::SyncProducer;
 use tokio::time::Instant as TokioInstant;
 
-/// The device's RPDO1 as the master sends it: a 16-bit word.
-#[derive(Debug, PartialEq)]
-struct Command(u16);
-
-impl od::Pdo for Command {
-    const DIRECTION: PdoDirection = PdoDirection::Rpdo;
-    const NUMBER: u16 = 1;
-    const COMMUNICATION_INDEX: u16 = 0x1400;
-    const MAPPING_INDEX: u16 = 0x1600;
-    const LEN: usize = 2;
-    const MAPPING: &'static [u32] = &[0x2002_0010];
-    fn default_cob_id(node_id: NodeId) -> Option<PdoCobId> {
-        Some(PdoCobId(0x200 + u32::from(node_id.get())))
-    }
-    fn decode(data: &[u8]) -> Result<Self, PdoLengthError> {
-        let bytes = eds2rust_runtime::pdo::layout::load::<2>(data)?;
-        Ok(Command(u16::from_le_bytes(*bytes)))
-    }
-    fn encode_into(&self, out: &mut [u8; 8]) -> usize {
-        out[..2].copy_from_slice(&self.0.to_le_bytes());
-        2
-    }
-}
+// The device's RPDO1 as the master sends it: a 16-bit word.
+word_pdo!(Command, Rpdo, 0x1400, 0x200, 0x2002_0010);
 
 #[tokio::test(start_paused = true)]
 async fn send_pdo_sends_the_typed_rpdo() {

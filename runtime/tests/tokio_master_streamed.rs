@@ -5,10 +5,10 @@
 //! writing what came; the next transfer works after each.
 #![cfg(feature = "tokio")]
 
-#[path = "tokio_master_rig.rs"]
-mod rig;
+#[macro_use]
+mod support;
 
-use rig::*;
+use support::tokio_rig::*;
 
 use std::io::{self, Read};
 use std::time::Duration;
@@ -161,12 +161,7 @@ async fn a_dropped_streamed_upload_is_aborted_and_the_next_succeeds() {
     // first segment comes, then nothing.
     let mut peer = rig.bus.attach();
     let script = tokio::spawn(async move {
-        let request = recv_from(&mut peer, 0x631).await.unwrap();
-        assert_eq!(request.to_string(), "631#4008100000000000");
-        let response = frame(0x5B1, &[0x41, 0x08, 0x10, 0x00, 20, 0, 0, 0]);
-        AsyncBus::send(&mut peer, &response).await.unwrap();
-        let segment = recv_from(&mut peer, 0x631).await.unwrap();
-        assert_eq!(segment.to_string(), "631#6000000000000000");
+        start_segmented_upload(&mut peer).await;
         let data = frame(0x5B1, &[0x00, b'e', b'd', b's', b'2', b'r', b'u', b's']);
         AsyncBus::send(&mut peer, &data).await.unwrap();
         let next = recv_from(&mut peer, 0x631).await.unwrap();
@@ -216,37 +211,17 @@ fn streamed_futures_are_send() {
     assert_send(&upload);
 }
 
-/// The COB-ID entry of TPDO1 (0x1800:01) as a one-element ARRAY, for the
-/// run-time element calls.
-struct Tpdo1CobId;
-
-impl od::Entry for Tpdo1CobId {
-    const INDEX: u16 = 0x1800;
-    const SUBINDEX: u8 = 1;
-    const NAME: &'static str = "TPDO1 COB-ID";
-    const DATA_TYPE: od::DataType = od::DataType::Unsigned32;
-    const PDO_MAPPABLE: bool = false;
-    type Access = od::access::Rw;
-    type Value = u32;
-}
+// The COB-ID entry of TPDO1 (0x1800:01) as a one-element ARRAY, for the
+// run-time element calls.
+entry!(Tpdo1CobId, 0x1800, 1, Unsigned32, Rw, u32);
 
 impl od::Array for Tpdo1CobId {
     const FIRST: u8 = 1;
     const LAST: u8 = 1;
 }
 
-/// The DOMAIN 0x2100:00 as a one-element ARRAY of bytes.
-struct Blobs;
-
-impl od::Entry for Blobs {
-    const INDEX: u16 = 0x2100;
-    const SUBINDEX: u8 = 0;
-    const NAME: &'static str = "Blobs";
-    const DATA_TYPE: od::DataType = od::DataType::Domain;
-    const PDO_MAPPABLE: bool = false;
-    type Access = od::access::Rw;
-    type Value = od::bytes::Domain;
-}
+// The DOMAIN 0x2100:00 as a one-element ARRAY of bytes.
+entry!(Blobs, 0x2100, 0, Domain, Rw, od::bytes::Domain);
 
 impl od::Array for Blobs {
     const FIRST: u8 = 0;

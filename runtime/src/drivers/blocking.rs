@@ -23,7 +23,7 @@ use std::vec::Vec;
 
 use crate::od::{self, Entry};
 use crate::sdo::client::{self, ClientConfig, Method};
-use crate::sdo::typed::{self, LengthNote};
+use crate::sdo::typed::LengthNote;
 pub use crate::time::Deadline;
 use crate::transport::{Bus, Clock};
 use crate::{Frame, Instant, Service};
@@ -225,7 +225,8 @@ pub(crate) fn recv_until<B: Bus + ?Sized>(
 
 pub use error::Error;
 pub(crate) use transfer::{
-    Object, Transfer, Upload, channel_node, encode, give_up, transfer_end, visible_string,
+    Object, Transfer, Upload, channel_node, encode, give_up, master_transfer_end, transfer_end,
+    visible_string,
 };
 
 /// A blocking SDO client for one node: each call runs one whole transfer.
@@ -259,9 +260,10 @@ impl<B: Bus> SdoClient<B> {
     }
 
     /// The notes typed reads left since the last call (at most
-    /// [`typed::NOTES_KEPT`], the newest): values the server sent longer
-    /// than their data type, of which the leading bytes were taken. Empty
-    /// with [`ClientConfig::strict_lengths`], which refuses them instead.
+    /// [`NOTES_KEPT`](crate::sdo::typed::NOTES_KEPT), the newest): values
+    /// the server sent longer than their data type, of which the leading
+    /// bytes were taken. Empty with [`ClientConfig::strict_lengths`], which
+    /// refuses them instead.
     pub fn take_length_notes(&mut self) -> Vec<LengthNote> {
         self.notes.drain(..).collect()
     }
@@ -458,12 +460,8 @@ impl<B: Bus> SdoClient<B> {
     {
         let upload = self.transfer(E::INDEX, sub, Transfer::Upload(Method::Auto))?;
         let strict = self.core.config().strict_lengths;
-        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)
-            .map_err(|e| self.object(E::INDEX, sub).value(e))?;
-        if let Some(note) = note {
-            typed::keep(&mut self.notes, note);
-        }
-        Ok(value)
+        let object = self.object(E::INDEX, sub);
+        upload.value::<E, _>(object, strict, &mut self.notes, |note| note)
     }
 
     /// Typed write of sub `sub` of `E`'s object.
@@ -473,8 +471,8 @@ impl<B: Bus> SdoClient<B> {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value, self.object(E::INDEX, sub))?;
-        self.download(E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
+        let encoded = encode::<E>(value, self.object(E::INDEX, sub))?;
+        self.download(E::INDEX, sub, encoded.bytes())
     }
 }
 

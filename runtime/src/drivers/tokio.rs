@@ -24,7 +24,7 @@ pub use crate::blocking::{Error, RunError};
 use crate::blocking::{Object, Transfer, Upload, encode, give_up, transfer_end, visible_string};
 use crate::od::{self, Entry};
 use crate::sdo::client::{self, ClientConfig, Method};
-use crate::sdo::typed::{self, LengthNote};
+use crate::sdo::typed::LengthNote;
 pub use crate::time::Deadline;
 use crate::transport::{AsyncBus, Clock};
 use crate::{Instant, Service};
@@ -158,14 +158,7 @@ where
             service.handle_timeout(current);
             continue;
         }
-        let wake = crate::time::earliest(deadline, timer)
-            .map(|at| ::tokio::time::Instant::from_std(clock.to_std(at)));
-        let sleep = async {
-            match wake {
-                Some(wake) => ::tokio::time::sleep_until(wake).await,
-                None => core::future::pending().await,
-            }
-        };
+        let sleep = sleep_until(clock, crate::time::earliest(deadline, timer));
         // `recv` is cancel-safe: when the timer or shutdown wins, no frame
         // is lost.
         ::tokio::select! {
@@ -177,6 +170,17 @@ where
             }
             () = sleep => {}
         }
+    }
+}
+
+/// Sleeps until `at` on `clock` (mapped to tokio's clock); forever
+/// without one.
+pub(crate) async fn sleep_until(clock: &Clock, at: Option<Instant>) {
+    match at {
+        Some(at) => {
+            ::tokio::time::sleep_until(::tokio::time::Instant::from_std(clock.to_std(at))).await
+        }
+        None => core::future::pending().await,
     }
 }
 
@@ -382,12 +386,8 @@ impl<B: AsyncBus> SdoClient<B> {
             .transfer(E::INDEX, sub, Transfer::Upload(Method::Auto))
             .await?;
         let strict = self.core.config().strict_lengths;
-        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)
-            .map_err(|e| self.object(E::INDEX, sub).value(e))?;
-        if let Some(note) = note {
-            typed::keep(&mut self.notes, note);
-        }
-        Ok(value)
+        let object = self.object(E::INDEX, sub);
+        upload.value::<E, _>(object, strict, &mut self.notes, |note| note)
     }
 
     /// Typed write of sub `sub` of `E`'s object.
@@ -397,9 +397,8 @@ impl<B: AsyncBus> SdoClient<B> {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value, self.object(E::INDEX, sub))?;
-        self.download(E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
-            .await
+        let encoded = encode::<E>(value, self.object(E::INDEX, sub))?;
+        self.download(E::INDEX, sub, encoded.bytes()).await
     }
 
     /// Reads the bytes of a string, DOMAIN or other byte-valued entry.

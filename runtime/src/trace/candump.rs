@@ -21,10 +21,10 @@
 
 use core::fmt;
 use core::time::Duration;
-use std::io::{self, BufRead, Read, Write};
+use std::io::{self, BufRead, Write};
 use std::string::{String, ToString};
-use std::vec::Vec;
 
+use super::lines::{LineError, Lines};
 use crate::{CanId, Frame};
 
 mod parse;
@@ -33,10 +33,7 @@ mod tests;
 
 pub use parse::{LogLineRef, parse_frame, parse_line, parse_line_ref};
 
-/// The longest line the [`Reader`] accepts, in bytes (a text-form line of an
-/// extended frame with a timestamp and a 15-character interface name is
-/// under 80).
-pub const MAX_LINE_LEN: usize = 1024;
+pub use super::lines::MAX_LINE_LEN;
 
 /// The interface name the [`Writer`] uses in the log and text forms for a
 /// line whose interface is empty.
@@ -203,110 +200,47 @@ impl From<ParseError> for Error {
 /// `Result<LogLine, Error>` that skips blank lines.
 #[derive(Debug)]
 pub struct Reader<R> {
-    input: R,
-    line: usize,
-    buf: Vec<u8>,
-    failed: bool,
+    lines: Lines<R>,
 }
 
 impl<R: BufRead> Reader<R> {
     /// A reader of `input`, starting at line 1.
     pub fn new(input: R) -> Reader<R> {
         Reader {
-            input,
-            line: 0,
-            buf: Vec::new(),
-            failed: false,
+            lines: Lines::new(input, 0),
         }
     }
 
     /// The number of the last line read (1-based; 0 before the first).
     pub fn line_number(&self) -> usize {
-        self.line
+        self.lines.number()
     }
 
     /// Gives the input back.
     pub fn into_inner(self) -> R {
-        self.input
+        self.lines.into_inner()
     }
-
-    /// Reads the next line into `buf`; `false` at the end of the input.
-    fn read_line(&mut self) -> io::Result<bool> {
-        let more = read_bounded_line(&mut self.input, &mut self.buf)?;
-        self.line += usize::from(more);
-        Ok(more)
-    }
-}
-
-/// Reads the next line of `input` into `buf` (cleared first); `false` at
-/// the end of the input. A line longer than [`MAX_LINE_LEN`] bytes (plus
-/// its line end) is consumed but only its start is kept: `buf` then holds
-/// more than [`MAX_LINE_LEN`] bytes, and nothing more is stored.
-pub(super) fn read_bounded_line<R: BufRead>(input: &mut R, buf: &mut Vec<u8>) -> io::Result<bool> {
-    buf.clear();
-    let limit = MAX_LINE_LEN as u64 + 2; // room for "\r\n"
-    let n = Read::take(&mut *input, limit).read_until(b'\n', buf)?;
-    if n == 0 {
-        return Ok(false);
-    }
-    if buf.last() != Some(&b'\n') && buf.len() as u64 == limit {
-        // Too long: skip the rest of the line without storing it.
-        loop {
-            let available = input.fill_buf()?;
-            if available.is_empty() {
-                break;
-            }
-            match available.iter().position(|&b| b == b'\n') {
-                Some(pos) => {
-                    input.consume(pos + 1);
-                    break;
-                }
-                None => {
-                    let len = available.len();
-                    input.consume(len);
-                }
-            }
-        }
-    }
-    Ok(true)
 }
 
 impl<R: BufRead> Iterator for Reader<R> {
     type Item = Result<LogLine, Error>;
 
     fn next(&mut self) -> Option<Self::Item> {
-        loop {
-            if self.failed {
-                return None;
-            }
-            match self.read_line() {
-                Ok(false) => return None,
-                Ok(true) => {}
-                Err(e) => {
-                    self.failed = true;
-                    return Some(Err(Error::Io(e)));
-                }
-            }
-            let error = |reason| {
-                Some(Err(Error::Parse(ParseError {
-                    line: self.line,
-                    reason,
-                })))
+        self.lines.next_item(|line, bytes| {
+            let error = |reason| Some(Err(Error::Parse(ParseError { line, reason })));
+            let bytes = match bytes {
+                Ok(bytes) => bytes,
+                Err(LineError::Io(e)) => return Some(Err(Error::Io(e))),
+                Err(LineError::TooLong) => return error(Reason::TooLong),
             };
-            let bytes = self.buf.strip_suffix(b"\n").unwrap_or(&self.buf);
-            let bytes = bytes.strip_suffix(b"\r").unwrap_or(bytes);
-            if bytes.len() > MAX_LINE_LEN {
-                return error(Reason::TooLong);
-            }
             let Ok(text) = core::str::from_utf8(bytes) else {
                 return error(Reason::NotUtf8);
             };
             match parse_line(text) {
-                Ok(Some(line)) => return Some(Ok(line)),
-                Ok(None) => continue,
-                Err(reason) => return error(reason),
+                Ok(line) => line.map(Ok),
+                Err(reason) => error(reason),
             }
-        }
+        })
     }
 }
 

@@ -1,14 +1,7 @@
+use super::test_support::{Rng, ext_frame, std_frame};
 use super::*;
 use crate::CanId;
-use std::io::Read;
-
-fn std_frame(id: u16, data: &[u8]) -> Frame {
-    Frame::new(CanId::Standard(id), data).unwrap()
-}
-
-fn ext_frame(id: u32, data: &[u8]) -> Frame {
-    Frame::new(CanId::Extended(id), data).unwrap()
-}
+use std::io::{self, Read};
 
 fn remote(id: u16, len: u8) -> Frame {
     Frame::remote(CanId::Standard(id), len).unwrap()
@@ -18,7 +11,7 @@ fn ms(millis: u64, micros: u64) -> Option<Duration> {
     Some(Duration::from_millis(millis) + Duration::from_micros(micros))
 }
 
-fn ok(line: usize, time: Option<Duration>, frame: Frame) -> Result<TraceLine, TraceError> {
+fn ok<E>(line: usize, time: Option<Duration>, frame: Frame) -> Result<TraceLine, E> {
     Ok(TraceLine { line, time, frame })
 }
 
@@ -26,6 +19,17 @@ fn ok(line: usize, time: Option<Duration>, frame: Frame) -> Result<TraceLine, Tr
 fn read(text: &str) -> Vec<Result<TraceLine, (usize, ErrorKind)>> {
     parse_str(text)
         .map(|r| r.map_err(|e| (e.line, e.kind)))
+        .collect()
+}
+
+/// Each item as (line, the frame or the error's message).
+fn summary(items: &[Result<TraceLine, TraceError>]) -> Vec<(usize, String)> {
+    items
+        .iter()
+        .map(|r| match r {
+            Ok(t) => (t.line, t.frame.to_string()),
+            Err(e) => (e.line, e.message.clone()),
+        })
         .collect()
 }
 
@@ -137,28 +141,16 @@ fn trc_version_2_0() {
     assert_eq!(
         items,
         [
-            Ok(TraceLine {
-                line: 7,
-                time: ms(100, 0),
-                frame: std_frame(0x80, &[])
-            }),
-            Ok(TraceLine {
-                line: 8,
-                time: ms(100, 250),
-                frame: std_frame(0x181, &[0x10, 0x27, 0, 0])
-            }),
+            ok(7, ms(100, 0), std_frame(0x80, &[])),
+            ok(8, ms(100, 250), std_frame(0x181, &[0x10, 0x27, 0, 0])),
             Err((9, ErrorKind::Skipped)),
             Err((10, ErrorKind::Skipped)),
-            Ok(TraceLine {
-                line: 11,
-                time: ms(102, 0),
-                frame: remote(0x281, 8)
-            }),
-            Ok(TraceLine {
-                line: 12,
-                time: ms(103, 0),
-                frame: ext_frame(0x1CEB_FF00, &[1, 2, 3, 4, 5, 6, 7, 8])
-            }),
+            ok(11, ms(102, 0), remote(0x281, 8)),
+            ok(
+                12,
+                ms(103, 0),
+                ext_frame(0x1CEB_FF00, &[1, 2, 3, 4, 5, 6, 7, 8])
+            ),
         ]
     );
 }
@@ -181,32 +173,14 @@ const TRC_2_1: &str = ";$FILEVERSION=2.1
 fn trc_version_2_1() {
     let items = read(TRC_2_1);
     assert_eq!(items.len(), 5);
-    assert_eq!(
-        items[0],
-        Ok(TraceLine {
-            line: 8,
-            time: ms(5, 0),
-            frame: std_frame(0, &[1, 5])
-        })
-    );
+    assert_eq!(items[0], ok(8, ms(5, 0), std_frame(0, &[1, 5])));
     assert_eq!(items[1], Err((9, ErrorKind::Skipped)));
     assert_eq!(
         items[2],
-        Ok(TraceLine {
-            line: 10,
-            time: ms(10, 125),
-            frame: std_frame(0x185, &[0, 1, 2, 3, 4, 5, 6, 7])
-        })
+        ok(10, ms(10, 125), std_frame(0x185, &[0, 1, 2, 3, 4, 5, 6, 7]))
     );
     assert_eq!(items[3], Err((11, ErrorKind::Skipped)));
-    assert_eq!(
-        items[4],
-        Ok(TraceLine {
-            line: 12,
-            time: ms(12, 0),
-            frame: remote(0x705, 1)
-        })
-    );
+    assert_eq!(items[4], ok(12, ms(12, 0), remote(0x705, 1)));
 }
 
 #[test]
@@ -225,23 +199,11 @@ fn trc_without_fileversion() {
     assert_eq!(
         items,
         [
-            Ok(TraceLine {
-                line: 4,
-                time: ms(1841, 0),
-                frame: std_frame(1, &[0; 8])
-            }),
+            ok(4, ms(1841, 0), std_frame(1, &[0; 8])),
             Err((5, ErrorKind::Skipped)),
             Err((6, ErrorKind::Skipped)),
-            Ok(TraceLine {
-                line: 7,
-                time: ms(1844, 0),
-                frame: remote(0x100, 3)
-            }),
-            Ok(TraceLine {
-                line: 8,
-                time: ms(1845, 500),
-                frame: ext_frame(0x123, &[0xAA])
-            }),
+            ok(7, ms(1844, 0), remote(0x100, 3)),
+            ok(8, ms(1845, 500), ext_frame(0x123, &[0xAA])),
         ]
     );
 }
@@ -346,14 +308,8 @@ fn long_lines_are_refused_without_storing_them() {
     input.extend(core::iter::repeat_n(b'B', MAX_LINE_LEN * 3)); // no line end
     let mut reader = Reader::new(&input[..]);
     let items: Vec<_> = reader.by_ref().collect();
-    assert!(reader.buf.capacity() <= 4 * MAX_LINE_LEN);
-    let summary: Vec<_> = items
-        .iter()
-        .map(|r| match r {
-            Ok(t) => (t.line, t.frame.to_string()),
-            Err(e) => (e.line, e.message.clone()),
-        })
-        .collect();
+    assert!(reader.lines.buffer_capacity() <= 4 * MAX_LINE_LEN);
+    let summary = summary(&items);
     let too_long = format!("the line is longer than {MAX_LINE_LEN} bytes");
     assert_eq!(
         summary,
@@ -377,13 +333,7 @@ fn non_utf8_lines() {
                   \xC3\x28 can0 123#\n\
                   101#02\n";
     let items = read_bytes(input);
-    let summary: Vec<_> = items
-        .iter()
-        .map(|r| match r {
-            Ok(t) => (t.line, t.frame.to_string()),
-            Err(e) => (e.line, e.message.clone()),
-        })
-        .collect();
+    let summary = summary(&items);
     let not_utf8 = "the line is not UTF-8 text".to_string();
     assert_eq!(
         summary,
@@ -434,18 +384,6 @@ fn read_failure_ends_the_reader() {
     );
 }
 
-/// A small xorshift generator: the test stays deterministic.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-}
-
 #[test]
 fn random_input_never_panics() {
     let pieces: [&[u8]; 24] = [
@@ -478,7 +416,7 @@ fn random_input_never_panics() {
     for _ in 0..300 {
         let mut bytes = Vec::new();
         for _ in 0..(rng.next() % 200) {
-            bytes.extend_from_slice(pieces[(rng.next() % pieces.len() as u64) as usize]);
+            bytes.extend_from_slice(pieces[rng.below(pieces.len())]);
         }
         let mut last = 0;
         for item in Reader::new(&bytes[..]) {

@@ -98,6 +98,19 @@ impl Sim {
         self.clock.now()
     }
 
+    /// After homing with `method` and a cyclic synchronous position run
+    /// through `targets`: the axis homed to 0, took the targets, and is in
+    /// CSP mode.
+    pub fn assert_homed_then_csp(&self, method: i8, targets: [i32; 3]) {
+        assert_eq!(self.homing_method, method);
+        assert_eq!(self.position, 0);
+        assert_eq!(self.csp_targets, targets);
+        assert_eq!(
+            self.device.mode(),
+            ModeOfOperation::CyclicSynchronousPosition
+        );
+    }
+
     /// Runs the device and the motion model to now.
     pub fn update(&mut self) {
         let now = self.now();

@@ -109,36 +109,25 @@ mod tests {
     use super::*;
     use crate::od::access;
 
-    struct U8Entry;
-    impl Entry for U8Entry {
-        const INDEX: u16 = 0x2000;
-        const SUBINDEX: u8 = 0;
-        const NAME: &'static str = "u8";
-        const DATA_TYPE: DataType = DataType::Unsigned8;
-        const PDO_MAPPABLE: bool = false;
-        type Access = access::Ro;
-        type Value = u8;
+    /// A read-only entry at (`$index`, 0) of `$ty`.
+    macro_rules! ro_entry {
+        ($name:ident, $index:literal, $ty:ident, $value:ty) => {
+            struct $name;
+            impl Entry for $name {
+                const INDEX: u16 = $index;
+                const SUBINDEX: u8 = 0;
+                const NAME: &'static str = stringify!($name);
+                const DATA_TYPE: DataType = DataType::$ty;
+                const PDO_MAPPABLE: bool = false;
+                type Access = access::Ro;
+                type Value = $value;
+            }
+        };
     }
-    struct I16Entry;
-    impl Entry for I16Entry {
-        const INDEX: u16 = 0x2001;
-        const SUBINDEX: u8 = 0;
-        const NAME: &'static str = "i16";
-        const DATA_TYPE: DataType = DataType::Integer16;
-        const PDO_MAPPABLE: bool = false;
-        type Access = access::Ro;
-        type Value = i16;
-    }
-    struct U24Entry;
-    impl Entry for U24Entry {
-        const INDEX: u16 = 0x2002;
-        const SUBINDEX: u8 = 0;
-        const NAME: &'static str = "u24";
-        const DATA_TYPE: DataType = DataType::Unsigned24;
-        const PDO_MAPPABLE: bool = false;
-        type Access = access::Ro;
-        type Value = u32;
-    }
+
+    ro_entry!(U8Entry, 0x2000, Unsigned8, u8);
+    ro_entry!(I16Entry, 0x2001, Integer16, i16);
+    ro_entry!(U24Entry, 0x2002, Unsigned24, u32);
 
     #[test]
     fn padded_expedited_data_gives_its_leading_bytes_silently() {

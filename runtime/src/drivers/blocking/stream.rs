@@ -9,10 +9,12 @@ use core::ops::ControlFlow;
 use core::time::Duration;
 use std::format;
 use std::io::{self, Read, Write};
-use std::vec::Vec;
 
-use super::{Error, Master, Object, RunError, SdoClient, give_up, run_loop, transfer_end};
-use crate::master::{self, MasterEvent};
+use super::{
+    Error, Master, Object, RunError, SdoClient, Upload, give_up, master_transfer_end, run_loop,
+    transfer_end,
+};
+use crate::master;
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::AbortCode;
 use crate::sdo::client::{self, ClientConfig, Method, Progress};
@@ -33,6 +35,7 @@ pub(crate) enum Stop {
 pub(crate) struct Pump<'a, R, W, P> {
     reader: Option<&'a mut R>,
     writer: Option<&'a mut W>,
+    pub(crate) plan: Plan,
     size: Option<usize>,
     fed: usize,
     done_reading: bool,
@@ -42,8 +45,66 @@ pub(crate) struct Pump<'a, R, W, P> {
     stop: Option<Stop>,
 }
 
+/// Which streamed transfer a [`Pump`] serves, and how it starts.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Plan {
+    /// A download announcing this many bytes (or none).
+    Download(Option<u32>, Method),
+    /// An upload.
+    Upload(Method),
+}
+
+impl Plan {
+    /// Starts the transfer of `object` on `core` (events left there from
+    /// before are dropped); returns its bound (see [`bound`]).
+    pub(crate) fn start(
+        self,
+        core: &mut client::SdoClient,
+        now: Instant,
+        object: Object,
+    ) -> Result<Option<Duration>, Error> {
+        while core.poll_event().is_some() {}
+        let (started, len) = match self {
+            Plan::Download(announced, method) => (
+                core.download_stream(now, object.index, object.sub, announced, method),
+                announced.map(|s| s as usize),
+            ),
+            Plan::Upload(method) => (
+                core.upload_stream(now, object.index, object.sub, method),
+                Some(core.config().max_upload),
+            ),
+        };
+        started.map_err(|client::Busy| object.busy())?;
+        Ok(bound(len, core.config()))
+    }
+}
+
+impl<'a, R: Read, P: FnMut(Progress)> Pump<'a, R, io::Sink, P> {
+    /// The pump of a download of what `reader` yields: `size` bytes when
+    /// given (announced in the initiate, at most u32::MAX).
+    pub(crate) fn download(
+        reader: &'a mut R,
+        size: Option<u64>,
+        method: Method,
+        progress: P,
+    ) -> Result<Self, Error> {
+        let announced = announced(size)?;
+        let plan = Plan::Download(announced, method);
+        let len = announced.map(|s| s as usize);
+        Ok(Pump::new(plan, Some(reader), None, len, progress))
+    }
+}
+
+impl<'a, W: Write, P: FnMut(Progress)> Pump<'a, io::Empty, W, P> {
+    /// The pump of an upload into `writer`.
+    pub(crate) fn upload(writer: &'a mut W, method: Method, progress: P) -> Self {
+        Pump::new(Plan::Upload(method), None, Some(writer), None, progress)
+    }
+}
+
 impl<'a, R: Read, W: Write, P: FnMut(Progress)> Pump<'a, R, W, P> {
-    pub(crate) fn new(
+    fn new(
+        plan: Plan,
         reader: Option<&'a mut R>,
         writer: Option<&'a mut W>,
         size: Option<usize>,
@@ -51,6 +112,7 @@ impl<'a, R: Read, W: Write, P: FnMut(Progress)> Pump<'a, R, W, P> {
     ) -> Self {
         Pump {
             done_reading: reader.is_none(),
+            plan,
             reader,
             writer,
             size,
@@ -165,32 +227,6 @@ pub(crate) fn announced(size: Option<u64>) -> Result<Option<u32>, Error> {
     }
 }
 
-/// Starts a streamed download of `object` announcing `announced` bytes on
-/// `core`.
-pub(crate) fn start_download(
-    core: &mut client::SdoClient,
-    now: Instant,
-    object: Object,
-    announced: Option<u32>,
-    method: Method,
-) -> Result<(), Error> {
-    while core.poll_event().is_some() {}
-    core.download_stream(now, object.index, object.sub, announced, method)
-        .map_err(|client::Busy| object.busy())
-}
-
-/// Starts a streamed upload of `object` on `core`.
-pub(crate) fn start_upload(
-    core: &mut client::SdoClient,
-    now: Instant,
-    object: Object,
-    method: Method,
-) -> Result<(), Error> {
-    while core.poll_event().is_some() {}
-    core.upload_stream(now, object.index, object.sub, method)
-        .map_err(|client::Busy| object.busy())
-}
-
 /// The error of a streamed transfer of `object` (bounded by `limit`) the
 /// driver loop ended with `error`: the source's or sink's when the pump
 /// stopped it (the transfer is then aborted with 0x08000000), else what
@@ -215,39 +251,56 @@ pub(crate) fn stream_error<R, W, P>(
     }
 }
 
-/// Reports the end of a download (all that was fed) when the last
-/// progress seen fell short of it.
-pub(crate) fn finish_download<R, W, P: FnMut(Progress)>(pump: &mut Pump<'_, R, W, P>) {
-    if let Some(p) = pump.last
-        && p.done != pump.fed
-    {
-        (pump.progress)(Progress {
-            done: pump.fed,
-            total: p.total,
-        });
+impl<R, W: Write, P: FnMut(Progress)> Pump<'_, R, W, P> {
+    /// The end of the pump's transfer of `object` (bounded by `limit`)
+    /// that the driver loop ended with `result`: the bytes fed or written
+    /// ([`Pump::finish`]), or the error; an abort is then left in `core`
+    /// for the caller to send ([`stream_error`]).
+    pub(crate) fn end(
+        &mut self,
+        core: &mut client::SdoClient,
+        result: Result<Result<Upload, Error>, RunError>,
+        object: Object,
+        limit: Option<Duration>,
+    ) -> Result<usize, Error> {
+        match result {
+            Ok(Ok(upload)) => self.finish(&upload.data),
+            Ok(Err(e)) => Err(e),
+            Err(e) => Err(stream_error(core, self, e, object, limit)),
+        }
     }
-}
 
-/// Writes the rest an upload's end event carried, flushes, and reports the
-/// end; returns the bytes written in all.
-pub(crate) fn finish_upload<R, W: Write, P: FnMut(Progress)>(
-    pump: &mut Pump<'_, R, W, P>,
-    rest: &[u8],
-) -> Result<usize, Error> {
-    if let Some(writer) = pump.writer.as_deref_mut() {
-        writer
-            .write_all(rest)
-            .and_then(|()| writer.flush())
-            .map_err(Error::Sink)?;
+    /// Ends a transfer that went through: an upload's writer gets the rest
+    /// its end event carried and is flushed; the last progress report
+    /// says all was done. Returns the bytes fed (download) or written
+    /// (upload) in all.
+    pub(crate) fn finish(&mut self, rest: &[u8]) -> Result<usize, Error> {
+        if let Plan::Download(..) = self.plan {
+            if let Some(p) = self.last
+                && p.done != self.fed
+            {
+                (self.progress)(Progress {
+                    done: self.fed,
+                    total: p.total,
+                });
+            }
+            return Ok(self.fed);
+        }
+        if let Some(writer) = self.writer.as_deref_mut() {
+            writer
+                .write_all(rest)
+                .and_then(|()| writer.flush())
+                .map_err(Error::Sink)?;
+        }
+        let written = self.written + rest.len();
+        if let Some(p) = self.last {
+            (self.progress)(Progress {
+                done: written,
+                total: p.total,
+            });
+        }
+        Ok(written)
     }
-    let written = pump.written + rest.len();
-    if let Some(p) = pump.last {
-        (pump.progress)(Progress {
-            done: written,
-            total: p.total,
-        });
-    }
-    Ok(written)
 }
 
 impl<B: Bus> SdoClient<B> {
@@ -271,16 +324,8 @@ impl<B: Bus> SdoClient<B> {
         method: Method,
         progress: impl FnMut(Progress),
     ) -> Result<(), Error> {
-        let now = self.clock.now();
-        let announced = announced(size)?;
-        let object = self.object(index, sub);
-        start_download(&mut self.core, now, object, announced, method)?;
-        let len = announced.map(|s| s as usize);
-        let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
-        let total = bound(len, self.core.config());
-        self.run_stream(object, &mut pump, now, total)?;
-        finish_download(&mut pump);
-        Ok(())
+        let pump = Pump::download(reader, size, method, progress)?;
+        self.run_stream(index, sub, pump).map(drop)
     }
 
     /// Reads (index, sub) into `writer` as the data arrives, holding only
@@ -297,13 +342,7 @@ impl<B: Bus> SdoClient<B> {
         method: Method,
         progress: impl FnMut(Progress),
     ) -> Result<usize, Error> {
-        let now = self.clock.now();
-        let object = self.object(index, sub);
-        start_upload(&mut self.core, now, object, method)?;
-        let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);
-        let total = bound(Some(self.core.config().max_upload), self.core.config());
-        let rest = self.run_stream(object, &mut pump, now, total)?;
-        finish_upload(&mut pump, &rest)
+        self.run_stream(index, sub, Pump::upload(writer, method, progress))
     }
 
     /// [`SdoClient::download_from`] into the byte-valued entry `E` (a
@@ -340,16 +379,18 @@ impl<B: Bus> SdoClient<B> {
         self.upload_into(E::INDEX, E::SUBINDEX, writer, method, progress)
     }
 
-    /// Runs a started streamed transfer to its end; returns the upload
-    /// data the end event carried.
+    /// Runs the streamed transfer of `pump` on (index, sub) to its end;
+    /// returns the bytes fed or written ([`Pump::finish`]).
     fn run_stream<R: Read, W: Write, P: FnMut(Progress)>(
         &mut self,
-        object: Object,
-        pump: &mut Pump<'_, R, W, P>,
-        started: Instant,
-        bound: Option<Duration>,
-    ) -> Result<Vec<u8>, Error> {
-        let deadline = bound.map(|b| started + b);
+        index: u16,
+        sub: u8,
+        mut pump: Pump<'_, R, W, P>,
+    ) -> Result<usize, Error> {
+        let now = self.clock.now();
+        let object = self.object(index, sub);
+        let bound = pump.plan.start(&mut self.core, now, object)?;
+        let deadline = bound.map(|b| now + b);
         let mut until = |event| transfer_end(event, object);
         let mut hook = |core: &mut client::SdoClient, now| pump.round(core, now);
         let result = run_loop(
@@ -361,18 +402,14 @@ impl<B: Bus> SdoClient<B> {
             None,
             &mut hook,
         );
-        match result {
-            Ok(Ok(upload)) => Ok(upload.data),
-            Ok(Err(e)) => Err(e),
-            Err(e) => {
-                let error = stream_error(&mut self.core, pump, e, object, bound);
-                while let Some(frame) = self.core.poll_transmit() {
-                    // Best effort: the abort frame of a failing bus may not go.
-                    let _ = self.bus.send(&frame);
-                }
-                Err(error)
+        let end = pump.end(&mut self.core, result, object, bound);
+        if end.is_err() {
+            while let Some(frame) = self.core.poll_transmit() {
+                // Best effort: the abort frame of a failing bus may not go.
+                let _ = self.bus.send(&frame);
             }
         }
+        end
     }
 }
 
@@ -391,17 +428,8 @@ impl<B: Bus> Master<B> {
         method: Method,
         progress: impl FnMut(Progress),
     ) -> Result<(), Error> {
-        let now = self.now();
-        let announced = announced(size)?;
-        let object = Object::new(Some(node), index, sub);
-        let client = self.core_mut().sdo_or_default(node);
-        start_download(client, now, object, announced, method)?;
-        let len = announced.map(|s| s as usize);
-        let total = bound(len, client.config());
-        let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
-        self.run_stream(node, object, &mut pump, now, total)?;
-        finish_download(&mut pump);
-        Ok(())
+        let pump = Pump::download(reader, size, method, progress)?;
+        self.run_stream(node, index, sub, pump).map(drop)
     }
 
     /// [`SdoClient::upload_into`] from `node` while the master keeps
@@ -415,14 +443,8 @@ impl<B: Bus> Master<B> {
         method: Method,
         progress: impl FnMut(Progress),
     ) -> Result<usize, Error> {
-        let now = self.now();
-        let object = Object::new(Some(node), index, sub);
-        let client = self.core_mut().sdo_or_default(node);
-        start_upload(client, now, object, method)?;
-        let total = bound(Some(client.config().max_upload), client.config());
-        let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);
-        let rest = self.run_stream(node, object, &mut pump, now, total)?;
-        finish_upload(&mut pump, &rest)
+        let pump = Pump::upload(writer, method, progress);
+        self.run_stream(node, index, sub, pump)
     }
 
     /// [`Master::download_from`] into the byte-valued entry `E` of `node`
@@ -461,33 +483,28 @@ impl<B: Bus> Master<B> {
         self.upload_into(node, E::INDEX, E::SUBINDEX, writer, method, progress)
     }
 
+    /// Runs the streamed transfer of `pump` on (index, sub) of `node` to
+    /// its end; returns the bytes fed or written ([`Pump::finish`]).
     fn run_stream<R: Read, W: Write, P: FnMut(Progress)>(
         &mut self,
         node: NodeId,
-        object: Object,
-        pump: &mut Pump<'_, R, W, P>,
-        started: Instant,
-        bound: Option<Duration>,
-    ) -> Result<Vec<u8>, Error> {
-        let deadline = bound.map(|b| started + b);
-        let mut until = |event| match event {
-            MasterEvent::Sdo(n, e) if n == node => match transfer_end(e.clone(), object) {
-                ControlFlow::Break(result) => Ok(result),
-                ControlFlow::Continue(()) => Err(MasterEvent::Sdo(n, e)),
-            },
-            other => Err(other),
-        };
+        index: u16,
+        sub: u8,
+        mut pump: Pump<'_, R, W, P>,
+    ) -> Result<usize, Error> {
+        let now = self.now();
+        let object = Object::new(Some(node), index, sub);
+        let client = self.core_mut().sdo_or_default(node);
+        let bound = pump.plan.start(client, now, object)?;
+        let deadline = bound.map(|b| now + b);
+        let mut until = |event| master_transfer_end(event, object);
         let mut hook = |core: &mut master::Master, now| pump.round(core.sdo_or_default(node), now);
-        match self.wait_with(deadline, &mut until, &mut hook) {
-            Ok(Ok(upload)) => Ok(upload.data),
-            Ok(Err(e)) => Err(e),
-            Err(e) => {
-                let client = self.core_mut().sdo_or_default(node);
-                let error = stream_error(client, pump, e, object, bound);
-                // Best effort: the abort frame of a failing bus may not go.
-                let _ = self.flush();
-                Err(error)
-            }
+        let result = self.wait_with(deadline, &mut until, &mut hook);
+        let end = pump.end(self.core_mut().sdo_or_default(node), result, object, bound);
+        if end.is_err() {
+            // Best effort: the abort frame of a failing bus may not go.
+            let _ = self.flush();
         }
+        end
     }
 }

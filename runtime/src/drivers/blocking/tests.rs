@@ -4,7 +4,7 @@ use super::*;
 use crate::od::NodeId;
 use crate::sdo::{AbortCode, Channel, SdoError};
 use crate::transport::ManualClock;
-use crate::transport::virtual_bus::VirtualBus;
+use crate::transport::virtual_bus::{VirtualBus, VirtualPort};
 use crate::{CanId, Frame};
 
 /// A test core: sends `ping` once, reports every frame with id `listen`,
@@ -61,6 +61,15 @@ fn frame(id: u16, data: &[u8]) -> Frame {
     Frame::new(CanId::Standard(id), data).unwrap()
 }
 
+/// A bus, a port on it, and a manual clock (its handle and a clock on it).
+fn manual_rig() -> (VirtualBus, VirtualPort, ManualClock, Clock) {
+    let bus = VirtualBus::new();
+    let port = bus.attach();
+    let time = ManualClock::new();
+    let clock = time.clock();
+    (bus, port, time, clock)
+}
+
 #[test]
 fn run_sends_feeds_frames_and_stops_on_break() {
     let bus = VirtualBus::new();
@@ -89,10 +98,7 @@ fn run_sends_feeds_frames_and_stops_on_break() {
 
 #[test]
 fn run_runs_timers_and_honours_the_deadline() {
-    let bus = VirtualBus::new();
-    let mut port = bus.attach();
-    let time = ManualClock::new();
-    let clock = time.clock();
+    let (_bus, mut port, time, clock) = manual_rig();
     let mut core = Pinger::new(None, 0x200, Duration::from_millis(10));
     let mut ticks = Vec::new();
     let result = run(
@@ -117,11 +123,8 @@ fn run_runs_timers_and_honours_the_deadline() {
 
 #[test]
 fn a_manual_clock_takes_frames_already_there_and_never_waits() {
-    let bus = VirtualBus::new();
-    let mut port = bus.attach();
+    let (bus, mut port, time, clock) = manual_rig();
     let peer = bus.attach();
-    let time = ManualClock::new();
-    let clock = time.clock();
     let mut core = Pinger::new(None, 0x200, Duration::from_secs(3600));
     peer.transmit(&frame(0x200, &[1]));
     let real = std::time::Instant::now();
@@ -212,10 +215,7 @@ fn serve_ends_at_its_deadline() {
 
 #[test]
 fn run_and_serve_take_deadlines_in_the_cores_time() {
-    let bus = VirtualBus::new();
-    let mut port = bus.attach();
-    let time = ManualClock::new();
-    let clock = time.clock();
+    let (_bus, mut port, _time, clock) = manual_rig();
     let mut core = Pinger::new(None, 0x200, Duration::from_millis(10));
     let mut ticks = 0;
     let deadline = clock.now() + Duration::from_millis(35);

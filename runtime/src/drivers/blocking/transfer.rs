@@ -4,13 +4,16 @@
 
 use core::ops::ControlFlow;
 use core::time::Duration;
+use std::collections::VecDeque;
 use std::string::String;
 use std::vec::Vec;
 
 use super::{Error, RunError};
 use crate::frame::CanId;
+use crate::master::MasterEvent;
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::client::{self, ClientConfig, ClientEvent, Method};
+use crate::sdo::typed::{self, LengthNote};
 use crate::sdo::{AbortCode, Channel, SdoError};
 use crate::{Instant, Service};
 
@@ -141,6 +144,22 @@ pub(crate) fn transfer_end(
     }
 }
 
+/// The end of the master's transfer of `object` (of its node) that
+/// `event` brings: `Ok` with the uploaded data or the error, or the event
+/// given back (`Err`) for the master's queue when it is another one.
+pub(crate) fn master_transfer_end(
+    event: MasterEvent,
+    object: Object,
+) -> Result<Result<Upload, Error>, MasterEvent> {
+    match event {
+        MasterEvent::Sdo(n, e) if Some(n) == object.node => match transfer_end(e.clone(), object) {
+            ControlFlow::Break(result) => Ok(result),
+            ControlFlow::Continue(()) => Err(MasterEvent::Sdo(n, e)),
+        },
+        other => Err(other),
+    }
+}
+
 /// Ends a transfer of `object` the driver gives up on: aborts it on the
 /// core (the caller then sends the abort frame) and drops its events.
 /// `limit` is the bound on the whole transfer the run's deadline stood
@@ -199,9 +218,48 @@ pub(crate) fn visible_string(mut data: Vec<u8>, object: Object) -> Result<String
     String::from_utf8(data).map_err(|e| not_visible(e.utf8_error().valid_up_to(), 0))
 }
 
-/// The bus form of a typed value for `object`: a buffer and its used
-/// length.
-pub(crate) fn encode<E>(value: E::Value, object: Object) -> Result<([u8; 8], usize), Error>
+impl Upload {
+    /// The value of entry `E` this upload of `object` carried (see
+    /// [`typed::decode_upload`]; `strict` as [`ClientConfig::strict_lengths`]).
+    /// A note about a value longer than its type goes to `notes`, made by
+    /// `note`.
+    pub(crate) fn value<E, T>(
+        &self,
+        object: Object,
+        strict: bool,
+        notes: &mut VecDeque<T>,
+        note: impl FnOnce(LengthNote) -> T,
+    ) -> Result<E::Value, Error>
+    where
+        E: Entry,
+        E::Access: od::Read,
+        E::Value: od::Scalar,
+    {
+        let (value, length) =
+            typed::decode_upload::<E>(object.sub, &self.data, self.padded, strict)
+                .map_err(|e| object.value(e))?;
+        if let Some(length) = length {
+            typed::keep(notes, note(length));
+        }
+        Ok(value)
+    }
+}
+
+/// The bus form of a typed value (at most 8 bytes).
+pub(crate) struct Encoded {
+    buf: [u8; 8],
+    len: usize,
+}
+
+impl Encoded {
+    /// The bytes to download.
+    pub(crate) fn bytes(&self) -> &[u8] {
+        self.buf.get(..self.len).unwrap_or(&self.buf)
+    }
+}
+
+/// The bus form of a typed value for `object`.
+pub(crate) fn encode<E>(value: E::Value, object: Object) -> Result<Encoded, Error>
 where
     E: Entry,
     E::Access: od::Write,
@@ -209,5 +267,5 @@ where
 {
     let mut buf = [0u8; 8];
     let len = od::encode_value::<E>(value, &mut buf).map_err(|e| object.value(e))?;
-    Ok((buf, len))
+    Ok(Encoded { buf, len })
 }

@@ -1,25 +1,19 @@
 //! Streamed SDO transfers of the tokio [`SdoClient`]: a download read from
-//! an [`io::Read`] and an upload written to an [`io::Write`], neither held
-//! whole in memory, with a progress callback. The data side is the
-//! blocking driver's pump (`blocking::stream`), run in every round of the
-//! loop; see [`crate::tokio::Master::download_from`] for what a source
+//! an [`io::Read`](std::io::Read) and an upload written to an
+//! [`io::Write`](std::io::Write), neither held whole in memory, with a
+//! progress callback. The data side is the blocking driver's pump
+//! (`blocking::stream`), run in every round of the loop; see [`crate::tokio::Master::download_from`] for what a source
 //! that blocks means on a task.
 
-use core::time::Duration;
-use std::io::{self, Read, Write};
-use std::vec::Vec;
+use std::io::{Read, Write};
 
 use super::{Error, SdoClient, run_loop};
-use crate::blocking::Object;
-use crate::blocking::stream::{
-    Pump, announced, bound, finish_download, finish_upload, start_download, start_upload,
-    stream_error,
-};
+use crate::Service;
+use crate::blocking::stream::Pump;
 use crate::blocking::transfer_end;
 use crate::od::{self, Entry};
 use crate::sdo::client::{self, Method, Progress};
 use crate::transport::AsyncBus;
-use crate::{Instant, Service};
 
 impl<B: AsyncBus> SdoClient<B> {
     /// Writes the value `reader` yields to (index, sub) without holding it
@@ -38,16 +32,8 @@ impl<B: AsyncBus> SdoClient<B> {
         R: Read + Send,
         P: FnMut(Progress) + Send,
     {
-        let start = self.clock.now();
-        let announced = announced(size)?;
-        let object = self.object(index, sub);
-        start_download(&mut self.core, start, object, announced, method)?;
-        let len = announced.map(|s| s as usize);
-        let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
-        let limit = bound(len, self.core.config());
-        self.run_stream(object, &mut pump, start, limit).await?;
-        finish_download(&mut pump);
-        Ok(())
+        let pump = Pump::download(reader, size, method, progress)?;
+        self.run_stream(index, sub, pump).await.map(drop)
     }
 
     /// Reads (index, sub) into `writer` as the data arrives; returns the
@@ -64,13 +50,8 @@ impl<B: AsyncBus> SdoClient<B> {
         W: Write + Send,
         P: FnMut(Progress) + Send,
     {
-        let start = self.clock.now();
-        let object = self.object(index, sub);
-        start_upload(&mut self.core, start, object, method)?;
-        let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);
-        let limit = bound(Some(self.core.config().max_upload), self.core.config());
-        let rest = self.run_stream(object, &mut pump, start, limit).await?;
-        finish_upload(&mut pump, &rest)
+        self.run_stream(index, sub, Pump::upload(writer, method, progress))
+            .await
     }
 
     /// [`SdoClient::download_from`] into the byte-valued entry `E`:
@@ -112,21 +93,23 @@ impl<B: AsyncBus> SdoClient<B> {
             .await
     }
 
-    /// Runs a started streamed transfer to its end; returns the upload
-    /// data the end event carried.
+    /// Runs the streamed transfer of `pump` on (index, sub) to its end;
+    /// returns the bytes fed or written (see the blocking driver's).
     async fn run_stream<R, W, P>(
         &mut self,
-        object: Object,
-        pump: &mut Pump<'_, R, W, P>,
-        started: Instant,
-        limit: Option<Duration>,
-    ) -> Result<Vec<u8>, Error>
+        index: u16,
+        sub: u8,
+        mut pump: Pump<'_, R, W, P>,
+    ) -> Result<usize, Error>
     where
         R: Read + Send,
         W: Write + Send,
         P: FnMut(Progress) + Send,
     {
-        let deadline = limit.map(|b| started + b);
+        let start = self.clock.now();
+        let object = self.object(index, sub);
+        let limit = pump.plan.start(&mut self.core, start, object)?;
+        let deadline = limit.map(|b| start + b);
         let mut until = |event| transfer_end(event, object);
         let mut hook = |core: &mut client::SdoClient, now| pump.round(core, now);
         let stop = core::future::pending();
@@ -140,17 +123,13 @@ impl<B: AsyncBus> SdoClient<B> {
             &mut hook,
         )
         .await;
-        match result {
-            Ok(Ok(upload)) => Ok(upload.data),
-            Ok(Err(e)) => Err(e),
-            Err(e) => {
-                let error = stream_error(&mut self.core, pump, e, object, limit);
-                while let Some(frame) = self.core.poll_transmit() {
-                    // Best effort: the abort frame of a failing bus may not go.
-                    let _ = self.bus.send(&frame).await;
-                }
-                Err(error)
+        let end = pump.end(&mut self.core, result, object, limit);
+        if end.is_err() {
+            while let Some(frame) = self.core.poll_transmit() {
+                // Best effort: the abort frame of a failing bus may not go.
+                let _ = self.bus.send(&frame).await;
             }
         }
+        end
     }
 }

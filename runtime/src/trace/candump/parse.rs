@@ -5,6 +5,7 @@ use core::time::Duration;
 use std::string::ToString;
 
 use super::{LogLine, Reason};
+use crate::trace::hex::{can_id, hex_value, parse_hex_byte};
 use crate::{CanId, Frame};
 
 /// One candump line borrowing its interface name from the text: what
@@ -169,12 +170,7 @@ fn parse_id(text: &str) -> Result<CanId, Reason> {
         3 | 8 => u32::from_str_radix(text, 16).map_err(|_| Reason::BadIdentifier)?,
         _ => return Err(Reason::BadIdentifier),
     };
-    let id = if text.len() == 3 {
-        u16::try_from(value).ok().and_then(CanId::standard)
-    } else {
-        CanId::extended(value)
-    };
-    id.ok_or(Reason::IdentifierOutOfRange(value))
+    can_id(value, text.len() == 3).ok_or(Reason::IdentifierOutOfRange(value))
 }
 
 /// A single digit 0 to 8.
@@ -183,17 +179,6 @@ fn parse_len(text: &str) -> Option<u8> {
         [d @ b'0'..=b'8'] => Some(d - b'0'),
         _ => None,
     }
-}
-
-fn parse_hex_byte(text: &str) -> Option<u8> {
-    match text.as_bytes() {
-        [h, l] => Some(hex_value(*h)? << 4 | hex_value(*l)?),
-        _ => None,
-    }
-}
-
-fn hex_value(digit: u8) -> Option<u8> {
-    char::from(digit).to_digit(16).map(|v| v as u8)
 }
 
 /// `(seconds.fraction)`: up to 9 fraction digits; seconds alone allowed.

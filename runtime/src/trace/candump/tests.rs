@@ -1,8 +1,5 @@
 use super::*;
-
-fn std_frame(id: u16, data: &[u8]) -> Frame {
-    Frame::new(CanId::Standard(id), data).unwrap()
-}
+use crate::trace::test_support::{Rng, std_frame};
 
 fn ts(secs: u64, micros: u32) -> Duration {
     Duration::new(secs, micros * 1000)
@@ -266,21 +263,6 @@ fn writer_fills_in_missing_parts() {
         line.display(Format::Text).to_string(),
         "  can0  181   [2]  01 02"
     );
-}
-
-/// A small deterministic generator (xorshift64).
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        self.0
-    }
-    fn below(&mut self, n: usize) -> usize {
-        (self.next() % n as u64) as usize
-    }
 }
 
 #[test]

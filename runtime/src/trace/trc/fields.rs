@@ -4,6 +4,7 @@
 use core::time::Duration;
 
 use super::Reason;
+use crate::trace::hex::{can_id, parse_hex_byte};
 use crate::{CanId, Frame};
 
 /// Data bytes, exactly `len` of them.
@@ -36,12 +37,7 @@ pub(super) fn parse_id(text: &str) -> Result<CanId, Reason> {
         return Err(Reason::BadIdentifier);
     }
     let value = u32::from_str_radix(text, 16).map_err(|_| Reason::BadIdentifier)?;
-    let id = if text.len() <= 4 {
-        u16::try_from(value).ok().and_then(CanId::standard)
-    } else {
-        CanId::extended(value)
-    };
-    id.ok_or(Reason::IdentifierOutOfRange(value))
+    can_id(value, text.len() <= 4).ok_or(Reason::IdentifierOutOfRange(value))
 }
 
 /// A length of 0 to 8 (one or two digits).
@@ -51,17 +47,6 @@ pub(super) fn parse_len(text: &str) -> Result<u8, Reason> {
         [b'0', d @ b'0'..=b'8'] => Ok(d - b'0'),
         _ => Err(Reason::BadLength),
     }
-}
-
-fn parse_hex_byte(text: &str) -> Option<u8> {
-    match text.as_bytes() {
-        [h, l] => Some(hex_value(*h)? << 4 | hex_value(*l)?),
-        _ => None,
-    }
-}
-
-fn hex_value(digit: u8) -> Option<u8> {
-    char::from(digit).to_digit(16).map(|v| v as u8)
 }
 
 pub(super) fn is_digits(text: &str) -> bool {

@@ -1,13 +1,6 @@
 use super::*;
 use crate::CanId;
-
-fn std_frame(id: u16, data: &[u8]) -> Frame {
-    Frame::new(CanId::Standard(id), data).unwrap()
-}
-
-fn ext_frame(id: u32, data: &[u8]) -> Frame {
-    Frame::new(CanId::Extended(id), data).unwrap()
-}
+use crate::trace::test_support::{ext_frame, std_frame};
 
 fn ms(millis: u64, micros: u64) -> Duration {
     Duration::from_millis(millis) + Duration::from_micros(micros)

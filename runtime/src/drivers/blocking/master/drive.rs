@@ -12,7 +12,6 @@ use std::collections::VecDeque;
 use std::vec::Vec;
 
 use super::Master;
-use crate::Instant;
 use crate::blocking::Error;
 use crate::cia402::session::{Action, OperationError, Read, Request, Session, SessionConfig};
 use crate::cia402::{Event, Move, State, Statusword, object};
@@ -20,6 +19,7 @@ use crate::master::MasterEvent;
 use crate::od::{self, DataType, Entry, NodeId, ObjectInfo};
 use crate::pdo::PdoEvent;
 use crate::transport::Bus;
+use crate::{CanId, Instant};
 
 /// Events a [`DriveHandle`] without observer keeps for
 /// [`DriveHandle::take_events`]; the oldest beyond are dropped.
@@ -107,12 +107,7 @@ impl<B: Bus> Master<B> {
         on_event: &mut dyn FnMut(Instant, Event),
     ) -> Result<(), Error> {
         loop {
-            let now = self.now();
-            let action = session.poll_action(now);
-            while let Some(event) = session.poll_event() {
-                on_event(now, event);
-            }
-            match action {
+            match next_action(session, self.now(), on_event) {
                 Action::Write(write) => {
                     let (index, sub) = (write.index, write.sub);
                     self.download(node, index, sub, &write.value.to_le_bytes())?;
@@ -127,21 +122,12 @@ impl<B: Bus> Master<B> {
                     session.on_error_code(code.map(u16::to_le_bytes).as_ref().map(|c| &c[..]));
                 }
                 Action::Wait(until) => {
-                    let pdo = self.run_until(until, |event| match event {
-                        MasterEvent::Pdo(PdoEvent::Received {
-                            can_id,
-                            data,
-                            len,
-                            at,
-                        }) if session.is_statusword_pdo(*can_id) => {
-                            ControlFlow::Break((*can_id, *data, *len, *at))
-                        }
-                        _ => ControlFlow::Continue(()),
+                    let pdo = self.run_until(until, |event| match statusword_pdo(session, event) {
+                        Some(pdo) => ControlFlow::Break(pdo),
+                        None => ControlFlow::Continue(()),
                     });
                     match pdo {
-                        Ok((can_id, data, len, at)) => {
-                            session.on_pdo(can_id, data.get(..len).unwrap_or(&[]), at);
-                        }
+                        Ok(pdo) => pdo.feed(session),
                         Err(Error::DeadlinePassed) => {}
                         Err(e) => return Err(e),
                     }
@@ -152,8 +138,111 @@ impl<B: Bus> Master<B> {
     }
 }
 
+/// The session's next action at `now`; the events it has are handed to
+/// `on_event` first.
+pub(crate) fn next_action(
+    session: &mut Session,
+    now: Instant,
+    on_event: &mut dyn FnMut(Instant, Event),
+) -> Action {
+    let action = session.poll_action(now);
+    while let Some(event) = session.poll_event() {
+        on_event(now, event);
+    }
+    action
+}
+
+/// A statusword TPDO the session waits for, as the master received it.
+pub(crate) struct StatuswordPdo {
+    can_id: CanId,
+    data: [u8; 8],
+    len: usize,
+    at: Instant,
+}
+
+impl StatuswordPdo {
+    /// Hands the PDO to `session`.
+    pub(crate) fn feed(&self, session: &mut Session) {
+        let data = self.data.get(..self.len).unwrap_or(&[]);
+        session.on_pdo(self.can_id, data, self.at);
+    }
+}
+
+/// The statusword TPDO of `session` that `event` brings, if it brings one.
+pub(crate) fn statusword_pdo(session: &Session, event: &MasterEvent) -> Option<StatuswordPdo> {
+    match *event {
+        MasterEvent::Pdo(PdoEvent::Received {
+            can_id,
+            data,
+            len,
+            at,
+        }) if session.is_statusword_pdo(can_id) => Some(StatuswordPdo {
+            can_id,
+            data,
+            len,
+            at,
+        }),
+        _ => None,
+    }
+}
+
+/// Where the events of a drive handle (blocking or tokio) go: to its
+/// observer (`O`, a closure) once one is set, or else into a log of the
+/// newest [`DRIVE_EVENTS_KEPT`].
+pub(crate) struct DriveEvents<O: ?Sized> {
+    observer: Option<Box<O>>,
+    log: VecDeque<(Instant, Event)>,
+}
+
+impl<O: ?Sized + FnMut(Instant, &Event)> DriveEvents<O> {
+    pub(crate) fn new() -> DriveEvents<O> {
+        DriveEvents {
+            observer: None,
+            log: VecDeque::new(),
+        }
+    }
+
+    /// The `Debug` form of the drive handle of `node` and `session` these
+    /// events belong to (whether it has an observer, not the closure).
+    pub(crate) fn debug_handle(
+        &self,
+        f: &mut fmt::Formatter<'_>,
+        node: NodeId,
+        session: &Session,
+    ) -> fmt::Result {
+        f.debug_struct("DriveHandle")
+            .field("node", &node)
+            .field("session", session)
+            .field("observer", &self.observer.is_some())
+            .finish_non_exhaustive()
+    }
+
+    /// Hands every event from now on to `observer`.
+    pub(crate) fn set_observer(&mut self, observer: Box<O>) {
+        self.observer = Some(observer);
+    }
+
+    /// The events kept since the last call.
+    pub(crate) fn take(&mut self) -> Vec<(Instant, Event)> {
+        self.log.drain(..).collect()
+    }
+
+    /// Hands `event`, seen `at`, to the observer, or else keeps it.
+    pub(crate) fn deliver(&mut self, at: Instant, event: Event) {
+        match &mut self.observer {
+            Some(observer) => observer(at, &event),
+            None => {
+                if self.log.len() >= DRIVE_EVENTS_KEPT {
+                    self.log.pop_front();
+                }
+                self.log.push_back((at, event));
+            }
+        }
+    }
+}
+
 /// The observer of a [`DriveHandle`].
-type Observer<'a> = Box<dyn FnMut(Instant, &Event) + 'a>;
+type Observer<'a> = dyn FnMut(Instant, &Event) + 'a;
 
 /// One CiA 402 drive on a blocking [`Master`] (see [`Master::drive`]).
 ///
@@ -167,17 +256,12 @@ pub struct DriveHandle<'a, B> {
     master: &'a mut Master<B>,
     node: NodeId,
     session: Session,
-    observer: Option<Observer<'a>>,
-    log: VecDeque<(Instant, Event)>,
+    events: DriveEvents<Observer<'a>>,
 }
 
 impl<B> fmt::Debug for DriveHandle<'_, B> {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("DriveHandle")
-            .field("node", &self.node)
-            .field("session", &self.session)
-            .field("observer", &self.observer.is_some())
-            .finish_non_exhaustive()
+        self.events.debug_handle(f, self.node, &self.session)
     }
 }
 
@@ -188,36 +272,26 @@ impl<'a, B: Bus> DriveHandle<'a, B> {
             master,
             node,
             session,
-            observer: None,
-            log: VecDeque::new(),
+            events: DriveEvents::new(),
         }
     }
 
     /// Hands every event from now on to `observer` (with the time it was
     /// seen) instead of keeping it.
     pub fn on_event(&mut self, observer: impl FnMut(Instant, &Event) + 'a) {
-        self.observer = Some(Box::new(observer));
+        self.events.set_observer(Box::new(observer));
     }
 
     /// The events kept since the last call (at most [`DRIVE_EVENTS_KEPT`],
     /// the newest), when no observer is set.
     pub fn take_events(&mut self) -> Vec<(Instant, Event)> {
-        self.log.drain(..).collect()
+        self.events.take()
     }
 
     /// Runs one request (every other call is this one).
     pub fn request(&mut self, request: Request) -> Result<(), Error> {
-        let observer = &mut self.observer;
-        let log = &mut self.log;
-        let mut on_event = |at: Instant, event: Event| match observer {
-            Some(observer) => observer(at, &event),
-            None => {
-                if log.len() >= DRIVE_EVENTS_KEPT {
-                    log.pop_front();
-                }
-                log.push_back((at, event));
-            }
-        };
+        let events = &mut self.events;
+        let mut on_event = |at: Instant, event: Event| events.deliver(at, event);
         self.master
             .run_drive_request(self.node, &mut self.session, request, &mut on_event)
     }

@@ -29,6 +29,14 @@ fn heartbeats(monitor: &VirtualPort) -> usize {
         .count()
 }
 
+/// Stops at the first boot-up, with its node.
+fn boot_up(event: &MasterEvent) -> ControlFlow<NodeId> {
+    match event {
+        MasterEvent::Nmt(NmtEvent::BootUp(n)) => ControlFlow::Break(*n),
+        _ => ControlFlow::Continue(()),
+    }
+}
+
 #[test]
 fn run_until_takes_a_deadline_in_the_cores_time() {
     let (mut m, monitor, _bus) = rig();
@@ -49,21 +57,13 @@ fn run_until_breaks_on_an_event_before_a_core_deadline() {
     let peer = bus.attach();
     peer.transmit(&Frame::new(CanId::Standard(0x705), &[0x00]).unwrap());
     let got = m
-        .run_until(m.now() + Duration::from_secs(5), |e| match e {
-            MasterEvent::Nmt(NmtEvent::BootUp(n)) => ControlFlow::Break(*n),
-            _ => ControlFlow::Continue(()),
-        })
+        .run_until(m.now() + Duration::from_secs(5), boot_up)
         .unwrap();
     assert_eq!(got, node(5));
     // No deadline at all: a queued event is offered first.
     peer.transmit(&Frame::new(CanId::Standard(0x706), &[0x00]).unwrap());
     m.run_for(Duration::from_millis(5)).unwrap();
-    let got = m
-        .run_until(Deadline::NEVER, |e| match e {
-            MasterEvent::Nmt(NmtEvent::BootUp(n)) => ControlFlow::Break(*n),
-            _ => ControlFlow::Continue(()),
-        })
-        .unwrap();
+    let got = m.run_until(Deadline::NEVER, boot_up).unwrap();
     assert_eq!(got, node(6));
 }
 
@@ -84,12 +84,7 @@ fn a_passed_core_deadline_returns_at_once_and_std_deadlines_still_work() {
     assert!(std::time::Instant::now() >= deadline);
     // The end of time: no overflow, the call ends on its event.
     peer.transmit(&Frame::new(CanId::Standard(0x707), &[0x00]).unwrap());
-    let got = m
-        .run_until(Instant::MAX, |e| match e {
-            MasterEvent::Nmt(NmtEvent::BootUp(n)) => ControlFlow::Break(*n),
-            _ => ControlFlow::Continue(()),
-        })
-        .unwrap();
+    let got = m.run_until(Instant::MAX, boot_up).unwrap();
     assert_eq!(got, node(7));
 }
 

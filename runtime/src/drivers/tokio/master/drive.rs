@@ -11,20 +11,17 @@
 
 use core::fmt;
 use std::boxed::Box;
-use std::collections::VecDeque;
 use std::vec::Vec;
 
 use super::Master;
+use crate::Instant;
 use crate::blocking::Error;
 use crate::cia402::session::{Action, OperationError, Read, Request, Session, SessionConfig};
 use crate::cia402::{Event, Move, State, Statusword, object};
-use crate::master::MasterEvent;
 use crate::od::{NodeId, ObjectInfo};
-use crate::pdo::PdoEvent;
 use crate::tokio::Events;
-use crate::{CanId, Instant};
 
-pub use crate::blocking::DRIVE_EVENTS_KEPT;
+use crate::blocking::master::drive::{DriveEvents, StatuswordPdo, next_action, statusword_pdo};
 
 impl Master {
     /// A CiA 402 drive at `node` whose object table is `objects` (a
@@ -86,12 +83,7 @@ impl Master {
         on_event: &mut (dyn FnMut(Instant, Event) + Send),
     ) -> Result<(), Error> {
         loop {
-            let now = self.now();
-            let action = session.poll_action(now);
-            while let Some(event) = session.poll_event() {
-                on_event(now, event);
-            }
-            match action {
+            match next_action(session, self.now(), on_event) {
                 Action::Write(write) => {
                     let (index, sub) = (write.index, write.sub);
                     self.download(node, index, sub, &write.value.to_le_bytes())
@@ -114,9 +106,9 @@ impl Master {
                         Some(events) => {
                             ::tokio::select! {
                                 () = sleep => {}
-                                event = next_statusword_pdo(events, session) => {
-                                    if let Some((can_id, data, len, at)) = event {
-                                        session.on_pdo(can_id, data.get(..len).unwrap_or(&[]), at);
+                                pdo = next_statusword_pdo(events, session) => {
+                                    if let Some(pdo) = pdo {
+                                        pdo.feed(session);
                                     }
                                 }
                             }
@@ -130,19 +122,11 @@ impl Master {
 }
 
 /// The next statusword TPDO on `events` (`None` when the stream ends).
-async fn next_statusword_pdo(
-    events: &mut Events,
-    session: &Session,
-) -> Option<(CanId, [u8; 8], usize, Instant)> {
+async fn next_statusword_pdo(events: &mut Events, session: &Session) -> Option<StatuswordPdo> {
     loop {
-        match events.next().await? {
-            MasterEvent::Pdo(PdoEvent::Received {
-                can_id,
-                data,
-                len,
-                at,
-            }) if session.is_statusword_pdo(can_id) => return Some((can_id, data, len, at)),
-            _ => {}
+        let event = events.next().await?;
+        if let Some(pdo) = statusword_pdo(session, &event) {
+            return Some(pdo);
         }
     }
 }
@@ -160,30 +144,25 @@ impl Drop for CancelOnDrop<'_> {
 }
 
 /// The observer of a [`DriveHandle`].
-type Observer = Box<dyn FnMut(Instant, &Event) + Send>;
+type Observer = dyn FnMut(Instant, &Event) + Send;
 
 /// One CiA 402 drive on the tokio [`Master`] (see [`Master::drive`]): the
 /// async counterpart of [`blocking::DriveHandle`](crate::blocking::DriveHandle),
 /// with the same calls. The drive's [`Event`]s (state changes, faults) go
 /// to the observer ([`DriveHandle::on_event`]) as they happen, or else are
 /// kept for [`DriveHandle::take_events`] (the newest
-/// [`DRIVE_EVENTS_KEPT`]).
+/// [`DRIVE_EVENTS_KEPT`](crate::blocking::DRIVE_EVENTS_KEPT)).
 pub struct DriveHandle {
     master: Master,
     node: NodeId,
     session: Session,
     pdos: Option<Events>,
-    observer: Option<Observer>,
-    log: VecDeque<(Instant, Event)>,
+    events: DriveEvents<Observer>,
 }
 
 impl fmt::Debug for DriveHandle {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.debug_struct("DriveHandle")
-            .field("node", &self.node)
-            .field("session", &self.session)
-            .field("observer", &self.observer.is_some())
-            .finish_non_exhaustive()
+        self.events.debug_handle(f, self.node, &self.session)
     }
 }
 
@@ -198,37 +177,27 @@ impl DriveHandle {
             node,
             session,
             pdos,
-            observer: None,
-            log: VecDeque::new(),
+            events: DriveEvents::new(),
         }
     }
 
     /// Hands every event from now on to `observer` (with the time it was
     /// seen) instead of keeping it.
     pub fn on_event(&mut self, observer: impl FnMut(Instant, &Event) + Send + 'static) {
-        self.observer = Some(Box::new(observer));
+        self.events.set_observer(Box::new(observer));
     }
 
-    /// The events kept since the last call (at most [`DRIVE_EVENTS_KEPT`],
-    /// the newest), each with the time it was seen, when no observer is
-    /// set.
+    /// The events kept since the last call (at most
+    /// [`DRIVE_EVENTS_KEPT`](crate::blocking::DRIVE_EVENTS_KEPT), the
+    /// newest), each with the time it was seen, when no observer is set.
     pub fn take_events(&mut self) -> Vec<(Instant, Event)> {
-        self.log.drain(..).collect()
+        self.events.take()
     }
 
     /// Runs one request (every other call is this one).
     pub async fn request(&mut self, request: Request) -> Result<(), Error> {
-        let observer = &mut self.observer;
-        let log = &mut self.log;
-        let mut on_event = |at: Instant, event: Event| match observer {
-            Some(observer) => observer(at, &event),
-            None => {
-                if log.len() >= DRIVE_EVENTS_KEPT {
-                    log.pop_front();
-                }
-                log.push_back((at, event));
-            }
-        };
+        let events = &mut self.events;
+        let mut on_event = |at: Instant, event: Event| events.deliver(at, event);
         self.master
             .run_drive_request(
                 self.node,

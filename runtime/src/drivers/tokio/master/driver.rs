@@ -79,14 +79,7 @@ impl<B: AsyncBus> Driver<B> {
             if timer.is_some_and(|at| at <= self.shared.now()) {
                 continue;
             }
-            let wake =
-                timer.map(|at| ::tokio::time::Instant::from_std(self.shared.clock.to_std(at)));
-            let sleep = async {
-                match wake {
-                    Some(wake) => ::tokio::time::sleep_until(wake).await,
-                    None => core::future::pending().await,
-                }
-            };
+            let sleep = crate::tokio::sleep_until(&self.shared.clock, timer);
             // `recv` is cancel-safe (AsyncBus), and so is `notified`: a
             // wake-up that comes before the wait is kept as a permit.
             ::tokio::select! {

@@ -11,7 +11,6 @@ use crate::Instant;
 use crate::blocking::{Object, RunError, Transfer, Upload, encode, give_up, visible_string};
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::client::{self, Method};
-use crate::sdo::typed;
 
 /// Ends the transfer of a call that did not see its end (dropped, or past
 /// its bound `limit`): aborts it on the core and wakes the driver to send
@@ -380,12 +379,8 @@ impl Master {
             .await?;
         let mut state = self.shared.lock();
         let strict = state.core.sdo_or_default(node).config().strict_lengths;
-        let (value, note) = typed::decode_upload::<E>(sub, &upload.data, upload.padded, strict)
-            .map_err(|e| Object::new(Some(node), E::INDEX, sub).value(e))?;
-        if let Some(note) = note {
-            typed::keep(&mut state.notes, (node, note));
-        }
-        Ok(value)
+        let object = Object::new(Some(node), E::INDEX, sub);
+        upload.value::<E, _>(object, strict, &mut state.notes, |note| (node, note))
     }
 
     /// Typed write of sub `sub` of `E`'s object.
@@ -395,8 +390,7 @@ impl Master {
         E::Access: od::Write,
         E::Value: od::Scalar,
     {
-        let (buf, len) = encode::<E>(value, Object::new(Some(node), E::INDEX, sub))?;
-        self.download(node, E::INDEX, sub, buf.get(..len).unwrap_or(&buf))
-            .await
+        let encoded = encode::<E>(value, Object::new(Some(node), E::INDEX, sub))?;
+        self.download(node, E::INDEX, sub, encoded.bytes()).await
     }
 }

@@ -122,6 +122,33 @@ impl<T> Queue<T> {
     }
 }
 
+/// The methods [`Events`] and [`Pdos`] share: the size of their queue
+/// (of `$items`, one `$item` each) and what it dropped.
+macro_rules! queue_methods {
+    ($items:literal, $item:literal) => {
+        #[doc = concat!("Number of queued ", $items, ".")]
+        pub fn len(&self) -> usize {
+            self.queue.len()
+        }
+
+        #[doc = concat!("Whether no ", $item, " is queued.")]
+        pub fn is_empty(&self) -> bool {
+            self.len() == 0
+        }
+
+        #[doc = concat!("The ", $items, " dropped because the queue was full.")]
+        pub fn dropped(&self) -> u64 {
+            self.queue.dropped()
+        }
+
+        #[doc = concat!("Sets how many ", $items, " the queue keeps (at least 1); the oldest")]
+        /// beyond that are dropped and counted.
+        pub fn set_capacity(&mut self, capacity: usize) {
+            self.queue.set_capacity(capacity);
+        }
+    };
+}
+
 /// The events of a tokio [`super::Master`] that no call of it waited for
 /// (see [`super::Master::events`]), oldest first.
 ///
@@ -147,26 +174,7 @@ impl Events {
         self.queue.try_pop()
     }
 
-    /// Number of queued events.
-    pub fn len(&self) -> usize {
-        self.queue.len()
-    }
-
-    /// Whether no event is queued.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Events dropped because the queue was full.
-    pub fn dropped(&self) -> u64 {
-        self.queue.dropped()
-    }
-
-    /// Sets how many events the queue keeps (at least 1); the oldest
-    /// beyond that are dropped and counted.
-    pub fn set_capacity(&mut self, capacity: usize) {
-        self.queue.set_capacity(capacity);
-    }
+    queue_methods!("events", "event");
 
     /// Whether the driver stopped (queued events can still be taken).
     pub fn is_closed(&self) -> bool {
@@ -236,25 +244,7 @@ impl<P: od::Pdo> Pdos<P> {
         self.can_id
     }
 
-    /// Number of queued frames.
-    pub fn len(&self) -> usize {
-        self.queue.len()
-    }
-
-    /// Whether no frame is queued.
-    pub fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    /// Values dropped because the queue was full.
-    pub fn dropped(&self) -> u64 {
-        self.queue.dropped()
-    }
-
-    /// Sets how many values the queue keeps (at least 1).
-    pub fn set_capacity(&mut self, capacity: usize) {
-        self.queue.set_capacity(capacity);
-    }
+    queue_methods!("values", "value");
 }
 
 /// The value of a PDO event the driver queued for a [`Pdos`] (only

@@ -1,6 +1,6 @@
 //! Streamed SDO transfers of the tokio [`Master`]: a download read from an
-//! [`io::Read`] and an upload written to an [`io::Write`], neither held
-//! whole in memory, with a progress callback. The data side is the
+//! [`io::Read`](std::io::Read) and an upload written to an
+//! [`io::Write`](std::io::Write), neither held whole in memory, with a progress callback. The data side is the
 //! blocking master's pump (`blocking::stream`), run on the calling task
 //! after every frame the driver receives; the transfer itself is the
 //! master's ordinary one (turns, bound, abort when dropped).
@@ -14,16 +14,11 @@
 //! [`WINDOW`]: crate::sdo::client::WINDOW
 
 use core::ops::ControlFlow;
-use core::time::Duration;
-use std::io::{self, Read, Write};
-use std::vec::Vec;
+
+use std::io::{Read, Write};
 
 use super::{Error, Master};
-use crate::Instant;
-use crate::blocking::stream::{
-    Pump, announced, bound, finish_download, finish_upload, start_download, start_upload,
-    stream_error,
-};
+use crate::blocking::stream::{Pump, stream_error};
 use crate::blocking::{Object, RunError};
 use crate::od::{self, Entry, NodeId};
 use crate::sdo::client::{self, Method, Progress};
@@ -50,18 +45,8 @@ impl Master {
         R: Read + Send,
         P: FnMut(Progress) + Send,
     {
-        let announced = announced(size)?;
-        let len = announced.map(|s| s as usize);
-        let mut pump = Pump::new(Some(reader), None::<&mut io::Sink>, len, progress);
-        let object = Object::new(Some(node), index, sub);
-        let start = |client: &mut client::SdoClient, now| {
-            start_download(client, now, object, announced, method)?;
-            Ok(bound(len, client.config()))
-        };
-        self.run_stream(node, (index, sub), &mut pump, start)
-            .await?;
-        finish_download(&mut pump);
-        Ok(())
+        let pump = Pump::download(reader, size, method, progress)?;
+        self.run_stream(node, (index, sub), pump).await.map(drop)
     }
 
     /// Reads (index, sub) of `node` into `writer` as the data arrives;
@@ -81,16 +66,8 @@ impl Master {
         W: Write + Send,
         P: FnMut(Progress) + Send,
     {
-        let mut pump = Pump::new(None::<&mut io::Empty>, Some(writer), None, progress);
-        let object = Object::new(Some(node), index, sub);
-        let start = |client: &mut client::SdoClient, now| {
-            start_upload(client, now, object, method)?;
-            Ok(bound(Some(client.config().max_upload), client.config()))
-        };
-        let rest = self
-            .run_stream(node, (index, sub), &mut pump, start)
-            .await?;
-        finish_upload(&mut pump, &rest)
+        let pump = Pump::upload(writer, method, progress);
+        self.run_stream(node, (index, sub), pump).await
     }
 
     /// [`Master::download_from`] into the byte-valued entry `E` (a DOMAIN
@@ -135,31 +112,37 @@ impl Master {
             .await
     }
 
-    /// Runs a streamed transfer that `start` begins on the node's client
-    /// (giving the transfer's bound), the pump after every frame; returns
-    /// the upload data the end event carried.
+    /// Runs the streamed transfer of `pump` on (index, sub) of `node`
+    /// (started on the node's client, which gives the bound), the pump
+    /// after every frame; returns the bytes fed or written.
     async fn run_stream<R, W, P>(
         &self,
         node: NodeId,
         (index, sub): (u16, u8),
-        pump: &mut Pump<'_, R, W, P>,
-        start: impl FnOnce(&mut client::SdoClient, Instant) -> Result<Option<Duration>, Error>,
-    ) -> Result<Vec<u8>, Error>
+        mut pump: Pump<'_, R, W, P>,
+    ) -> Result<usize, Error>
     where
         R: Read,
         W: Write,
         P: FnMut(Progress),
     {
+        let object = Object::new(Some(node), index, sub);
+        let plan = pump.plan;
+        let start = move |client: &mut client::SdoClient, now| plan.start(client, now, object);
         let round = |client: &mut client::SdoClient, now| match pump.round(client, now) {
             ControlFlow::Continue(()) => Ok(()),
             // The source or sink failed: its error, the abort queued.
-            ControlFlow::Break(()) => {
-                let object = Object::new(Some(node), index, sub);
-                Err(stream_error(client, pump, RunError::Stopped, object, None))
-            }
+            ControlFlow::Break(()) => Err(stream_error(
+                client,
+                &mut pump,
+                RunError::Stopped,
+                object,
+                None,
+            )),
         };
-        self.run_transfer(node, index, sub, start, Some(round))
-            .await
-            .map(|upload| upload.data)
+        let upload = self
+            .run_transfer(node, index, sub, start, Some(round))
+            .await?;
+        pump.finish(&upload.data)
     }
 }

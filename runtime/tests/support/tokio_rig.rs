@@ -1,55 +1,30 @@
 //! The rig of the tokio master tests (`tokio_master.rs`,
-//! `tokio_master_events.rs`): the virtual bus under tokio's paused clock,
+//! `tokio_master_events.rs`, `tokio_master_pdo.rs`,
+//! `tokio_master_streamed.rs`): the virtual bus under tokio's paused clock,
 //! the master and its driver task, a device assembled from the runtime's
 //! sans-IO services (SDO server, NMT slave, heartbeat producer, LSS slave,
 //! a TPDO transmitter) served on a task, and a monitor port that sees
-//! every frame. Compiled on its own it holds no tests.
-#![cfg(feature = "tokio")]
-#![allow(dead_code)]
+//! every frame.
 
 use std::time::Duration;
 
-use eds2rust_runtime::heartbeat::HeartbeatProducer;
 use eds2rust_runtime::lss::{BitRate, BitTiming, Identity, LssSlave};
 use eds2rust_runtime::master::{self, MasterEvent};
-use eds2rust_runtime::nmt::NmtSlave;
-use eds2rust_runtime::od::{
-    self, AccessRight, DataType, Entry, NodeId, PdoDirection, PdoLengthError, access,
-};
+use eds2rust_runtime::od::{self, AccessRight};
 use eds2rust_runtime::pdo::{PdoCobId, PdoTransmitter, TransmissionType, TransmitterConfig};
-use eds2rust_runtime::sdo::Channel;
-use eds2rust_runtime::sdo::server::{MemoryStore, SdoServer, ServerConfig};
+use eds2rust_runtime::sdo::server::MemoryStore;
 use eds2rust_runtime::tokio::{self as driver, Deadline, Events, Master};
 use eds2rust_runtime::transport::AsyncBus;
 use eds2rust_runtime::transport::virtual_bus::{VirtualBus, VirtualPort};
-use eds2rust_runtime::{CanId, Frame, Instant, Service};
+use eds2rust_runtime::{Frame, Instant, Service};
 use tokio::task::JoinHandle;
 
 pub const DEVICE: u8 = 0x20;
 pub const IDENTITY: Identity = Identity::new(0x0000_02A5, 0x1234, 7, 0xBEEF);
 
-pub fn node(id: u8) -> NodeId {
-    NodeId::new(id).unwrap()
-}
-
-pub fn frame(id: u16, data: &[u8]) -> Frame {
-    Frame::new(CanId::Standard(id), data).unwrap()
-}
-
-macro_rules! entry {
-    ($name:ident, $index:literal, $sub:literal, $ty:ident, $access:ident, $value:ty) => {
-        pub struct $name;
-        impl Entry for $name {
-            const INDEX: u16 = $index;
-            const SUBINDEX: u8 = $sub;
-            const NAME: &'static str = stringify!($name);
-            const DATA_TYPE: DataType = DataType::$ty;
-            const PDO_MAPPABLE: bool = false;
-            type Access = access::$access;
-            type Value = $value;
-        }
-    };
-}
+// What the tests take with `tokio_rig::*`; each uses some of it.
+#[allow(unused_imports)]
+pub use super::{BasicDevice, assert_sdo_timeout, frame, node};
 
 entry!(ProducerHeartbeatTime, 0x1017, 0, Unsigned16, Rw, u16);
 entry!(
@@ -62,43 +37,20 @@ entry!(
 );
 entry!(Blob, 0x2100, 0, Domain, Rw, od::bytes::Domain);
 
-/// The device's TPDO1: a 16-bit counter at 0x2001:00.
-#[derive(Debug, PartialEq)]
-pub struct Counter(pub u16);
-
-impl od::Pdo for Counter {
-    const DIRECTION: PdoDirection = PdoDirection::Tpdo;
-    const NUMBER: u16 = 1;
-    const COMMUNICATION_INDEX: u16 = 0x1800;
-    const MAPPING_INDEX: u16 = 0x1A00;
-    const LEN: usize = 2;
-    const MAPPING: &'static [u32] = &[0x2001_0010];
-    fn default_cob_id(node_id: NodeId) -> Option<PdoCobId> {
-        Some(PdoCobId(0x180 + u32::from(node_id.get())))
-    }
-    fn decode(data: &[u8]) -> Result<Self, PdoLengthError> {
-        let bytes = eds2rust_runtime::pdo::layout::load::<2>(data)?;
-        Ok(Counter(u16::from_le_bytes(*bytes)))
-    }
-    fn encode_into(&self, out: &mut [u8; 8]) -> usize {
-        out[..2].copy_from_slice(&self.0.to_le_bytes());
-        2
-    }
-}
+// The device's TPDO1: a 16-bit counter at 0x2001:00.
+word_pdo!(Counter, Tpdo, 0x1800, 0x180, 0x2001_0010);
 
 /// The device: SDO server, NMT slave, heartbeat every 50 ms, LSS slave,
 /// TPDO1 (a counter, sent at every SYNC and counted up after it).
 pub struct Device {
-    sdo: SdoServer<MemoryStore>,
-    nmt: NmtSlave,
-    heartbeat: HeartbeatProducer,
+    basic: BasicDevice<MemoryStore>,
     lss: LssSlave,
     tpdo: PdoTransmitter,
     counter: u16,
 }
 
 impl Device {
-    fn new() -> Device {
+    fn new(now: Instant) -> Device {
         let id = node(DEVICE);
         let mut store = MemoryStore::new();
         store.insert_fixed(0x1017, 0, AccessRight::Rw, &50u16.to_le_bytes());
@@ -116,9 +68,7 @@ impl Device {
         .unwrap();
         tpdo.set_data(Instant::ZERO, &0u16.to_le_bytes()).unwrap();
         Device {
-            sdo: SdoServer::new(ServerConfig::new(Channel::default_for(id)), store),
-            nmt: NmtSlave::new(id),
-            heartbeat: HeartbeatProducer::new(id, Some(Duration::from_millis(50))),
+            basic: BasicDevice::new(id, store, now),
             lss: LssSlave::new(IDENTITY, Some(id), BitTiming::standard(BitRate::Kbit500)),
             tpdo,
             counter: 0,
@@ -129,10 +79,7 @@ impl Device {
 impl Service for Device {
     type Event = ();
     fn handle_frame(&mut self, now: Instant, frame: &Frame) {
-        self.sdo.handle_frame(now, frame);
-        self.nmt.handle_frame(now, frame);
-        while self.nmt.poll_event().is_some() {}
-        self.heartbeat.set_state(self.nmt.state());
+        self.basic.handle_frame(now, frame);
         self.lss.handle_frame(now, frame);
         while self.lss.poll_event().is_some() {}
         self.tpdo.handle_frame(now, frame);
@@ -143,26 +90,19 @@ impl Service for Device {
         }
     }
     fn handle_timeout(&mut self, now: Instant) {
-        if self.sdo.poll_timeout().is_some_and(|at| at <= now) {
-            self.sdo.handle_timeout(now);
-        }
-        if self.heartbeat.poll_timeout().is_some_and(|at| at <= now) {
-            self.heartbeat.handle_timeout(now);
-        }
+        self.basic.handle_timeout(now);
     }
     fn poll_transmit(&mut self) -> Option<Frame> {
-        self.sdo
+        self.basic
             .poll_transmit()
-            .or_else(|| self.heartbeat.poll_transmit())
             .or_else(|| self.lss.poll_transmit())
             .or_else(|| self.tpdo.poll_transmit())
     }
     fn poll_event(&mut self) -> Option<()> {
-        while self.sdo.poll_event().is_some() {}
-        None
+        self.basic.poll_event()
     }
     fn poll_timeout(&self) -> Option<Instant> {
-        eds2rust_runtime::time::earliest(self.sdo.poll_timeout(), self.heartbeat.poll_timeout())
+        self.basic.poll_timeout()
     }
 }
 
@@ -170,10 +110,7 @@ impl Service for Device {
 pub fn spawn_device(mut port: VirtualPort) -> JoinHandle<()> {
     tokio::spawn(async move {
         let clock = driver::clock();
-        let mut device = Device::new();
-        device.nmt.boot_complete();
-        device.heartbeat.set_state(device.nmt.state());
-        device.heartbeat.start(clock.now());
+        let mut device = Device::new(clock.now());
         let pending = std::future::pending();
         let _ = driver::serve(
             &mut port,
@@ -223,6 +160,16 @@ impl Rig {
         std::iter::from_fn(|| self.monitor.try_recv()).collect()
     }
 
+    /// The frames with `cob_id` the monitor saw since the last call (of
+    /// this or [`Rig::seen`]), as text.
+    pub fn seen_on(&self, cob_id: u16) -> Vec<String> {
+        self.seen()
+            .iter()
+            .filter(|f| f.standard_id() == Some(cob_id))
+            .map(Frame::to_string)
+            .collect()
+    }
+
     /// Waits (in virtual time) for the first event `pick` takes.
     pub async fn wait_for<T>(&mut self, mut pick: impl FnMut(&MasterEvent) -> Option<T>) -> T {
         let within = Duration::from_secs(10);
@@ -237,6 +184,17 @@ impl Rig {
         .await
         .expect("no such event within 10 s")
     }
+}
+
+/// Plays node 0x31 on `peer`: answers the upload of 0x1008:00 with a
+/// segmented initiate of 20 bytes and takes the first segment request.
+pub async fn start_segmented_upload(peer: &mut VirtualPort) {
+    let request = recv_from(peer, 0x631).await.unwrap();
+    assert_eq!(request.to_string(), "631#4008100000000000");
+    let response = frame(0x5B1, &[0x41, 0x08, 0x10, 0x00, 20, 0, 0, 0]);
+    AsyncBus::send(peer, &response).await.unwrap();
+    let segment = recv_from(peer, 0x631).await.unwrap();
+    assert_eq!(segment.to_string(), "631#6000000000000000");
 }
 
 /// The next frame `port` receives with `cob_id`.
