@@ -19,4 +19,6 @@ pub mod nmt;
 pub mod pdo;
 pub mod sdo;
 pub mod sync;
+#[cfg(test)]
+pub(crate) mod testing;
 pub mod time_stamp;

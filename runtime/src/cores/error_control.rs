@@ -20,3 +20,69 @@ pub fn parse_error_control(frame: &Frame) -> Option<(NodeId, u8)> {
         _ => None,
     }
 }
+
+/// One optional entry per node id (1 to 127; slot 0 stays empty): what the
+/// NMT master, the heartbeat consumer and node guarding keep of each node.
+#[derive(Debug, Clone)]
+pub(crate) struct PerNode<T>([Option<T>; 128]);
+
+impl<T: Copy> PerNode<T> {
+    /// No entry for any node.
+    pub(crate) const fn new() -> PerNode<T> {
+        PerNode([None; 128])
+    }
+
+    /// The entry of `node`.
+    pub(crate) fn get(&self, node: NodeId) -> Option<&T> {
+        self.0.get(usize::from(node.get()))?.as_ref()
+    }
+
+    /// The entry of `node`, to change.
+    pub(crate) fn get_mut(&mut self, node: NodeId) -> Option<&mut T> {
+        self.0.get_mut(usize::from(node.get()))?.as_mut()
+    }
+
+    /// Replaces the entry of `node` (`None` removes it); returns the old one.
+    pub(crate) fn set(&mut self, node: NodeId, entry: Option<T>) -> Option<T> {
+        let slot = self.0.get_mut(usize::from(node.get()))?;
+        core::mem::replace(slot, entry)
+    }
+
+    /// Sets the entry of every node.
+    pub(crate) fn set_all(&mut self, entry: Option<T>) {
+        for slot in self.0.iter_mut().skip(1) {
+            *slot = entry;
+        }
+    }
+
+    /// The entries.
+    pub(crate) fn iter(&self) -> impl Iterator<Item = &T> {
+        self.0.iter().flatten()
+    }
+
+    /// The nodes with an entry, in id order, with their entries.
+    pub(crate) fn iter_mut(&mut self) -> impl Iterator<Item = (NodeId, &mut T)> {
+        self.0.iter_mut().enumerate().filter_map(|(i, slot)| {
+            let node = u8::try_from(i).ok().and_then(NodeId::new)?;
+            Some((node, slot.as_mut()?))
+        })
+    }
+
+    /// The first node from slot `from` on (wrapping after 127) whose entry
+    /// `pick` takes, for serving the nodes in turn.
+    pub(crate) fn next_from(
+        &mut self,
+        from: usize,
+        mut pick: impl FnMut(&mut T) -> bool,
+    ) -> Option<NodeId> {
+        let len = self.0.len();
+        (0..len).map(|step| (from + step) % len).find_map(|i| {
+            let entry = self.0.get_mut(i)?.as_mut()?;
+            if pick(entry) {
+                u8::try_from(i).ok().and_then(NodeId::new)
+            } else {
+                None
+            }
+        })
+    }
+}

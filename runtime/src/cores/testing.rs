@@ -1,0 +1,35 @@
+//! Test helpers shared by the cores' unit tests: the frames, instants and
+//! node ids the tests are written in, and draining a core's output.
+
+use crate::od::NodeId;
+use crate::{CanId, Frame, Instant, Service};
+
+/// Node `n` (1 to 127).
+pub(crate) fn node(n: u8) -> NodeId {
+    NodeId::new(n).unwrap()
+}
+
+/// A data frame on the 11-bit identifier `id`.
+pub(crate) fn data(id: u16, bytes: &[u8]) -> Frame {
+    Frame::new(CanId::Standard(id), bytes).unwrap()
+}
+
+/// A remote frame on the 11-bit identifier `id`, DLC 1.
+pub(crate) fn rtr(id: u16) -> Frame {
+    Frame::remote(CanId::Standard(id), 1).unwrap()
+}
+
+/// `n` milliseconds after the epoch.
+pub(crate) fn ms(n: u64) -> Instant {
+    Instant::from_millis(n)
+}
+
+/// Every frame `s` has to send.
+pub(crate) fn frames<S: Service>(s: &mut S) -> Vec<Frame> {
+    core::iter::from_fn(|| s.poll_transmit()).collect()
+}
+
+/// Every event `s` has to report.
+pub(crate) fn events<S: Service>(s: &mut S) -> Vec<S::Event> {
+    core::iter::from_fn(|| s.poll_event()).collect()
+}
