@@ -252,6 +252,47 @@ fn put_segment(d: &mut [u8; 8], toggle: bool, last: bool, data: &[u8; 7], len: u
     d[1..1 + len as usize].copy_from_slice(&data[..len as usize]);
 }
 
+/// The size of a block initiate of the data's sender (block download
+/// request, block upload response): bytes 4-7 when `s` (bit 1) is set.
+fn block_size_field(d: &[u8; 8]) -> Option<u32> {
+    bit(d[0], 1).then(|| u32_at(d))
+}
+
+/// The end of a block transfer sent by the data's sender: unused bytes of
+/// the last segment in bits 4-2, the CRC in bytes 1-2.
+fn block_end(d: &[u8; 8]) -> (u8, u16) {
+    (d[0] >> 2 & 7, u16::from_le_bytes([d[1], d[2]]))
+}
+
+/// A block initiate of the data's sender: CRC flag bit 2, size flag bit 1,
+/// the size in bytes 4-7.
+fn put_block_send(d: &mut [u8; 8], index: u16, sub: u8, crc: bool, size: Option<u32>) {
+    d[0] = 0xC0 | (crc as u8) << 2 | (size.is_some() as u8) << 1;
+    put_address(d, index, sub);
+    d[4..8].copy_from_slice(&size.unwrap_or(0).to_le_bytes());
+}
+
+fn put_block_end(d: &mut [u8; 8], unused: u8, crc: u16) {
+    d[0] = 0xC1 | (unused & 7) << 2;
+    d[1..3].copy_from_slice(&crc.to_le_bytes());
+}
+
+/// A block initiate of the data's receiver (block upload request, block
+/// download response): CRC flag bit 2, the block size in byte 4.
+fn put_block_receive(d: &mut [u8; 8], index: u16, sub: u8, crc: bool, block_size: u8) {
+    d[0] = 0xA0 | (crc as u8) << 2;
+    put_address(d, index, sub);
+    d[4] = block_size;
+}
+
+/// The receiver's acknowledgement of a sub-block: the last sequence number
+/// received in byte 1, the next block size in byte 2.
+fn put_block_ack(d: &mut [u8; 8], ack_seq: u8, block_size: u8) {
+    d[0] = 0xA2;
+    d[1] = ack_seq;
+    d[2] = block_size;
+}
+
 fn put_abort(d: &mut [u8; 8], index: u16, sub: u8, code: AbortCode) {
     d[0] = 0x80;
     put_address(d, index, sub);
@@ -300,20 +341,19 @@ impl Request {
                 },
                 _ => Request::BlockUploadStart,
             },
-            6 => {
-                if b & 1 == 0 {
-                    Request::BlockDownloadInitiate {
-                        index,
-                        sub,
-                        crc: bit(b, 2),
-                        size: bit(b, 1).then(|| u32_at(d)),
-                    }
-                } else {
-                    Request::BlockDownloadEnd {
-                        unused: b >> 2 & 7,
-                        crc: u16::from_le_bytes([d[1], d[2]]),
-                    }
+            6 if b & 1 == 0 => {
+                let crc = bit(b, 2);
+                let size = block_size_field(d);
+                Request::BlockDownloadInitiate {
+                    index,
+                    sub,
+                    crc,
+                    size,
                 }
+            }
+            6 => {
+                let (unused, crc) = block_end(d);
+                Request::BlockDownloadEnd { unused, crc }
             }
             _ => return Err(ParseError::Command(b)),
         })
@@ -350,14 +390,9 @@ impl Request {
                 crc,
                 size,
             } => {
-                d[0] = 0xC0 | (crc as u8) << 2 | (size.is_some() as u8) << 1;
-                put_address(&mut d, index, sub);
-                d[4..8].copy_from_slice(&size.unwrap_or(0).to_le_bytes());
+                put_block_send(&mut d, index, sub, crc, size);
             }
-            Request::BlockDownloadEnd { unused, crc } => {
-                d[0] = 0xC1 | (unused & 7) << 2;
-                d[1..3].copy_from_slice(&crc.to_le_bytes());
-            }
+            Request::BlockDownloadEnd { unused, crc } => put_block_end(&mut d, unused, crc),
             Request::BlockUploadInitiate {
                 index,
                 sub,
@@ -365,20 +400,14 @@ impl Request {
                 block_size,
                 pst,
             } => {
-                d[0] = 0xA0 | (crc as u8) << 2;
-                put_address(&mut d, index, sub);
-                d[4] = block_size;
+                put_block_receive(&mut d, index, sub, crc, block_size);
                 d[5] = pst;
             }
             Request::BlockUploadStart => d[0] = 0xA3,
             Request::BlockUploadAck {
                 ack_seq,
                 block_size,
-            } => {
-                d[0] = 0xA2;
-                d[1] = ack_seq;
-                d[2] = block_size;
-            }
+            } => put_block_ack(&mut d, ack_seq, block_size),
             Request::BlockUploadEnd => d[0] = 0xA1,
             Request::Abort { index, sub, code } => put_abort(&mut d, index, sub, code),
         }
@@ -477,20 +506,19 @@ impl Response {
                 },
                 _ => return Err(ParseError::Command(b)),
             },
-            6 => {
-                if b & 1 == 0 {
-                    Response::BlockUploadInitiate {
-                        index,
-                        sub,
-                        crc: bit(b, 2),
-                        size: bit(b, 1).then(|| u32_at(d)),
-                    }
-                } else {
-                    Response::BlockUploadEnd {
-                        unused: b >> 2 & 7,
-                        crc: u16::from_le_bytes([d[1], d[2]]),
-                    }
+            6 if b & 1 == 0 => {
+                let crc = bit(b, 2);
+                let size = block_size_field(d);
+                Response::BlockUploadInitiate {
+                    index,
+                    sub,
+                    crc,
+                    size,
                 }
+            }
+            6 => {
+                let (unused, crc) = block_end(d);
+                Response::BlockUploadEnd { unused, crc }
             }
             _ => return Err(ParseError::Command(b)),
         })
@@ -526,19 +554,11 @@ impl Response {
                 sub,
                 crc,
                 block_size,
-            } => {
-                d[0] = 0xA0 | (crc as u8) << 2;
-                put_address(&mut d, index, sub);
-                d[4] = block_size;
-            }
+            } => put_block_receive(&mut d, index, sub, crc, block_size),
             Response::BlockDownloadAck {
                 ack_seq,
                 block_size,
-            } => {
-                d[0] = 0xA2;
-                d[1] = ack_seq;
-                d[2] = block_size;
-            }
+            } => put_block_ack(&mut d, ack_seq, block_size),
             Response::BlockDownloadEnd => d[0] = 0xA1,
             Response::BlockUploadInitiate {
                 index,
@@ -546,14 +566,9 @@ impl Response {
                 crc,
                 size,
             } => {
-                d[0] = 0xC0 | (crc as u8) << 2 | (size.is_some() as u8) << 1;
-                put_address(&mut d, index, sub);
-                d[4..8].copy_from_slice(&size.unwrap_or(0).to_le_bytes());
+                put_block_send(&mut d, index, sub, crc, size);
             }
-            Response::BlockUploadEnd { unused, crc } => {
-                d[0] = 0xC1 | (unused & 7) << 2;
-                d[1..3].copy_from_slice(&crc.to_le_bytes());
-            }
+            Response::BlockUploadEnd { unused, crc } => put_block_end(&mut d, unused, crc),
             Response::Abort { index, sub, code } => put_abort(&mut d, index, sub, code),
         }
         d
