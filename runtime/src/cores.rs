@@ -5,6 +5,18 @@
 //!
 //! The modules are re-exported at the crate root, where their documentation is.
 
+/// `Default` for the cores whose default is their `new()` (a `const fn`,
+/// which `Default::default` cannot be): the one place that says so.
+macro_rules! default_is_new {
+    ($core:ty) => {
+        impl Default for $core {
+            fn default() -> Self {
+                <$core>::new()
+            }
+        }
+    };
+}
+
 #[cfg(feature = "alloc")]
 pub mod boot;
 pub mod cia402;

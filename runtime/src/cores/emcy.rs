@@ -238,11 +238,7 @@ pub struct EmcyConsumer {
     events: Ring<EmcyEvent, CONSUMER_EVENTS>,
 }
 
-impl Default for EmcyConsumer {
-    fn default() -> Self {
-        EmcyConsumer::new()
-    }
-}
+default_is_new!(EmcyConsumer);
 
 impl EmcyConsumer {
     /// A consumer watching all nodes 1 to 127.

@@ -112,11 +112,7 @@ pub struct NodeGuard {
     events: Ring<GuardEvent, GUARD_EVENTS>,
 }
 
-impl Default for NodeGuard {
-    fn default() -> Self {
-        NodeGuard::new()
-    }
-}
+default_is_new!(NodeGuard);
 
 impl NodeGuard {
     /// A master guarding no node.

@@ -226,11 +226,7 @@ pub struct SyncConsumer {
     events: Ring<SyncEvent, CONSUMER_EVENTS>,
 }
 
-impl Default for SyncConsumer {
-    fn default() -> Self {
-        SyncConsumer::new()
-    }
-}
+default_is_new!(SyncConsumer);
 
 impl SyncConsumer {
     /// A consumer on COB-ID 0x080.

@@ -68,11 +68,7 @@ pub struct HeartbeatConsumer {
     events: Ring<HeartbeatEvent, CONSUMER_EVENTS>,
 }
 
-impl Default for HeartbeatConsumer {
-    fn default() -> Self {
-        HeartbeatConsumer::new()
-    }
-}
+default_is_new!(HeartbeatConsumer);
 
 impl HeartbeatConsumer {
     /// A consumer monitoring no node.

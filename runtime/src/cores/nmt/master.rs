@@ -57,11 +57,7 @@ pub struct NmtMaster {
     events: Ring<NmtEvent, MASTER_EVENTS>,
 }
 
-impl Default for NmtMaster {
-    fn default() -> Self {
-        NmtMaster::new()
-    }
-}
+default_is_new!(NmtMaster);
 
 impl NmtMaster {
     /// A master that knows nothing about any node yet.

@@ -319,11 +319,7 @@ pub struct TimeConsumer {
     events: Ring<TimeEvent, CONSUMER_EVENTS>,
 }
 
-impl Default for TimeConsumer {
-    fn default() -> Self {
-        TimeConsumer::new()
-    }
-}
+default_is_new!(TimeConsumer);
 
 impl TimeConsumer {
     /// A consumer on the 11-bit identifier 0x100.
