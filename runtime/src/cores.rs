@@ -17,6 +17,49 @@ macro_rules! default_is_new {
     };
 }
 
+/// A public enum coded as one byte on the bus: the enum (`#[repr(u8)]`),
+/// `from_byte` (`None` for other bytes), `to_byte` and `Display` (the
+/// text given for each value), written once for the NMT commands and
+/// states and the LSS states.
+macro_rules! byte_enum {
+    (
+        $(#[$meta:meta])*
+        pub enum $name:ident {
+            $($(#[$vmeta:meta])* $variant:ident = $byte:literal => $text:literal,)+
+        }
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        #[repr(u8)]
+        pub enum $name {
+            $($(#[$vmeta])* $variant = $byte,)+
+        }
+
+        impl $name {
+            /// The value coded `byte`; `None` for other bytes.
+            pub const fn from_byte(byte: u8) -> Option<$name> {
+                match byte {
+                    $($byte => Some($name::$variant),)+
+                    _ => None,
+                }
+            }
+
+            /// The byte coding this value.
+            pub const fn to_byte(self) -> u8 {
+                self as u8
+            }
+        }
+
+        impl core::fmt::Display for $name {
+            fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+                f.write_str(match self {
+                    $($name::$variant => $text,)+
+                })
+            }
+        }
+    };
+}
+
 #[cfg(feature = "alloc")]
 pub mod boot;
 pub mod cia402;

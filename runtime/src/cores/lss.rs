@@ -81,38 +81,13 @@ pub const ERROR_STORAGE_ACCESS: u8 = 2;
 /// reason is in the spec error byte.
 pub const ERROR_IMPLEMENTATION_SPECIFIC: u8 = 0xFF;
 
-/// The state of an LSS slave, also the mode byte of switch state global.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[repr(u8)]
-pub enum LssState {
-    /// Waiting: only switch services, identification and fastscan apply.
-    Waiting = 0,
-    /// Configuration: node id, bit timing, store and inquiry services apply.
-    Configuration = 1,
-}
-
-impl LssState {
-    /// The state with mode byte `byte`; `None` for other values.
-    pub const fn from_byte(byte: u8) -> Option<LssState> {
-        match byte {
-            0 => Some(LssState::Waiting),
-            1 => Some(LssState::Configuration),
-            _ => None,
-        }
-    }
-
-    /// The mode byte.
-    pub const fn to_byte(self) -> u8 {
-        self as u8
-    }
-}
-
-impl fmt::Display for LssState {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            LssState::Waiting => "waiting",
-            LssState::Configuration => "configuration",
-        })
+byte_enum! {
+    /// The state of an LSS slave, also the mode byte of switch state global.
+    pub enum LssState {
+        /// Waiting: only switch services, identification and fastscan apply.
+        Waiting = 0 => "waiting",
+        /// Configuration: node id, bit timing, store and inquiry services apply.
+        Configuration = 1 => "configuration",
     }
 }
 

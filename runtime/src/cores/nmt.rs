@@ -8,40 +8,23 @@ use crate::Frame;
 use crate::frame::cob;
 use crate::od::NodeId;
 
-/// An NMT module-control command (byte 0 of a frame on COB-ID 0x000).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[repr(u8)]
-pub enum NmtCommand {
-    /// Start remote node: enter Operational.
-    Start = 0x01,
-    /// Stop remote node: enter Stopped.
-    Stop = 0x02,
-    /// Enter Pre-operational.
-    EnterPreOperational = 0x80,
-    /// Reset the whole node (application and communication).
-    ResetNode = 0x81,
-    /// Reset the communication parameters only.
-    ResetCommunication = 0x82,
+byte_enum! {
+    /// An NMT module-control command (byte 0 of a frame on COB-ID 0x000).
+    pub enum NmtCommand {
+        /// Start remote node: enter Operational.
+        Start = 0x01 => "start",
+        /// Stop remote node: enter Stopped.
+        Stop = 0x02 => "stop",
+        /// Enter Pre-operational.
+        EnterPreOperational = 0x80 => "enter pre-operational",
+        /// Reset the whole node (application and communication).
+        ResetNode = 0x81 => "reset node",
+        /// Reset the communication parameters only.
+        ResetCommunication = 0x82 => "reset communication",
+    }
 }
 
 impl NmtCommand {
-    /// The command with command specifier `byte`; `None` for other values.
-    pub const fn from_byte(byte: u8) -> Option<NmtCommand> {
-        match byte {
-            0x01 => Some(NmtCommand::Start),
-            0x02 => Some(NmtCommand::Stop),
-            0x80 => Some(NmtCommand::EnterPreOperational),
-            0x81 => Some(NmtCommand::ResetNode),
-            0x82 => Some(NmtCommand::ResetCommunication),
-            _ => None,
-        }
-    }
-
-    /// The command specifier byte.
-    pub const fn to_byte(self) -> u8 {
-        self as u8
-    }
-
     /// The state a node is in once it has carried the command out (resets
     /// end in Pre-operational, after the boot-up message).
     pub const fn target_state(self) -> NmtState {
@@ -55,60 +38,19 @@ impl NmtCommand {
     }
 }
 
-impl fmt::Display for NmtCommand {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            NmtCommand::Start => "start",
-            NmtCommand::Stop => "stop",
-            NmtCommand::EnterPreOperational => "enter pre-operational",
-            NmtCommand::ResetNode => "reset node",
-            NmtCommand::ResetCommunication => "reset communication",
-        })
-    }
-}
-
-/// An NMT state as reported in boot-up, heartbeat and node-guarding frames
-/// (bits 6..0 of the state byte).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[repr(u8)]
-pub enum NmtState {
-    /// The boot-up message: the node has just (re)initialised.
-    BootUp = 0x00,
-    /// Stopped: only NMT and error control are active.
-    Stopped = 0x04,
-    /// Operational: all services, PDOs included, are active.
-    Operational = 0x05,
-    /// Pre-operational: all services but PDOs are active.
-    PreOperational = 0x7F,
-}
-
-impl NmtState {
-    /// The state with code `byte` (bit 7, the guarding toggle, must already
-    /// be masked off); `None` for other values.
-    pub const fn from_byte(byte: u8) -> Option<NmtState> {
-        match byte {
-            0x00 => Some(NmtState::BootUp),
-            0x04 => Some(NmtState::Stopped),
-            0x05 => Some(NmtState::Operational),
-            0x7F => Some(NmtState::PreOperational),
-            _ => None,
-        }
-    }
-
-    /// The state code.
-    pub const fn to_byte(self) -> u8 {
-        self as u8
-    }
-}
-
-impl fmt::Display for NmtState {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            NmtState::BootUp => "boot-up",
-            NmtState::Stopped => "stopped",
-            NmtState::Operational => "operational",
-            NmtState::PreOperational => "pre-operational",
-        })
+byte_enum! {
+    /// An NMT state as reported in boot-up, heartbeat and node-guarding frames
+    /// (bits 6..0 of the state byte; bit 7, the guarding toggle, must be
+    /// masked off before [`NmtState::from_byte`]).
+    pub enum NmtState {
+        /// The boot-up message: the node has just (re)initialised.
+        BootUp = 0x00 => "boot-up",
+        /// Stopped: only NMT and error control are active.
+        Stopped = 0x04 => "stopped",
+        /// Operational: all services, PDOs included, are active.
+        Operational = 0x05 => "operational",
+        /// Pre-operational: all services but PDOs are active.
+        PreOperational = 0x7F => "pre-operational",
     }
 }
 
