@@ -15,14 +15,13 @@ use core::fmt;
 
 mod array;
 mod info;
-mod rights;
+mod pdo;
 mod scaled;
 pub mod standard;
 
 pub use array::{Array, Element, Elements, array_subindex};
 pub use info::{DefaultValue, Number, ObjectInfo};
-use rights::sealed;
-pub use rights::{Access, AccessRight, Read, RpdoAccess, TpdoAccess, Write, access};
+pub use pdo::{Pdo, PdoDirection, PdoLengthError};
 pub use scaled::{Scaled, ScaledRaw};
 
 /// A CiA 301 basic data type.
@@ -91,6 +90,150 @@ impl DataType {
         )
     }
 }
+
+/// The access right of an entry, as a value.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum AccessRight {
+    Ro,
+    Wo,
+    Rw,
+    /// Read/write, mapped into a TPDO.
+    Rwr,
+    /// Read/write, mapped into an RPDO.
+    Rww,
+    Const,
+}
+
+/// Access rights as types; generated entries name one of these as
+/// [`Entry::Access`].
+pub mod access {
+    /// Read only.
+    pub enum Ro {}
+    /// Write only.
+    pub enum Wo {}
+    /// Read and write.
+    pub enum Rw {}
+    /// Read and write; meant for TPDO mapping (process input).
+    pub enum Rwr {}
+    /// Read and write; meant for RPDO mapping (process output).
+    pub enum Rww {}
+    /// Read only, never changes.
+    pub enum Const {}
+}
+
+mod sealed {
+    use super::access::{Const, Ro, Rw, Rwr, Rww, Wo};
+
+    pub trait Sealed {}
+    impl Sealed for Ro {}
+    impl Sealed for Wo {}
+    impl Sealed for Rw {}
+    impl Sealed for Rwr {}
+    impl Sealed for Rww {}
+    impl Sealed for Const {}
+
+    /// The access rights [`super::RpdoAccess`] is implemented for (no other
+    /// crate can add one).
+    pub trait RpdoSealed<E> {}
+    impl<E> RpdoSealed<E> for Wo {}
+    impl<E> RpdoSealed<E> for Rw {}
+    impl<E> RpdoSealed<E> for Rwr {}
+    impl<E> RpdoSealed<E> for Rww {}
+
+    /// The access rights [`super::TpdoAccess`] is implemented for.
+    pub trait TpdoSealed<E> {}
+    impl<E> TpdoSealed<E> for Ro {}
+    impl<E> TpdoSealed<E> for Rw {}
+    impl<E> TpdoSealed<E> for Rwr {}
+    impl<E> TpdoSealed<E> for Rww {}
+    impl<E> TpdoSealed<E> for Const {}
+}
+
+/// An access right as a type.
+pub trait Access: sealed::Sealed {
+    const RIGHT: AccessRight;
+}
+
+/// Access rights that allow reading over the bus.
+#[diagnostic::on_unimplemented(
+    message = "this object cannot be read: its access right is `{Self}`",
+    label = "a write-only object"
+)]
+pub trait Read: Access {}
+
+/// Access rights that allow writing over the bus.
+#[diagnostic::on_unimplemented(
+    message = "this object cannot be written: its access right is `{Self}`",
+    label = "a read-only or constant object"
+)]
+pub trait Write: Access {}
+
+impl Access for access::Ro {
+    const RIGHT: AccessRight = AccessRight::Ro;
+}
+impl Access for access::Wo {
+    const RIGHT: AccessRight = AccessRight::Wo;
+}
+impl Access for access::Rw {
+    const RIGHT: AccessRight = AccessRight::Rw;
+}
+impl Access for access::Rwr {
+    const RIGHT: AccessRight = AccessRight::Rwr;
+}
+impl Access for access::Rww {
+    const RIGHT: AccessRight = AccessRight::Rww;
+}
+impl Access for access::Const {
+    const RIGHT: AccessRight = AccessRight::Const;
+}
+
+impl Read for access::Ro {}
+impl Read for access::Rw {}
+impl Read for access::Rwr {}
+impl Read for access::Rww {}
+impl Read for access::Const {}
+
+impl Write for access::Wo {}
+impl Write for access::Rw {}
+impl Write for access::Rwr {}
+impl Write for access::Rww {}
+
+/// Access rights of objects that may be mapped into an RPDO: the device
+/// receives an RPDO and writes its values into the mapped objects, so they
+/// must be writable (wo, rw, rwr, rww; not ro or const).
+///
+/// Implemented by the access types of [`access`]; `E` is the entry being
+/// mapped, there only so that the compiler's error names it.
+#[diagnostic::on_unimplemented(
+    message = "`{E}` is read-only and cannot be mapped into an RPDO (the device receives RPDOs and writes their values)",
+    label = "its access right `{Self}` does not allow writing",
+    note = "a read-only object can be mapped into a TPDO (`tpdo_mapping_entry`) or read over SDO"
+)]
+pub trait RpdoAccess<E>: Write + sealed::RpdoSealed<E> {}
+
+/// Access rights of objects that may be mapped into a TPDO: the device
+/// reads the mapped objects and transmits their values, so they must be
+/// readable (ro, const, rw, rwr, rww; not wo).
+///
+/// Implemented by the access types of [`access`]; `E` is the entry being
+/// mapped, there only so that the compiler's error names it.
+#[diagnostic::on_unimplemented(
+    message = "`{E}` is write-only and cannot be mapped into a TPDO (the device transmits TPDOs and reads their values)",
+    label = "its access right `{Self}` does not allow reading",
+    note = "a write-only object can be mapped into an RPDO (`rpdo_mapping_entry`) or written over SDO"
+)]
+pub trait TpdoAccess<E>: Read + sealed::TpdoSealed<E> {}
+
+impl<E> RpdoAccess<E> for access::Wo {}
+impl<E> RpdoAccess<E> for access::Rw {}
+impl<E> RpdoAccess<E> for access::Rwr {}
+impl<E> RpdoAccess<E> for access::Rww {}
+
+impl<E> TpdoAccess<E> for access::Ro {}
+impl<E> TpdoAccess<E> for access::Rw {}
+impl<E> TpdoAccess<E> for access::Rwr {}
+impl<E> TpdoAccess<E> for access::Rww {}
+impl<E> TpdoAccess<E> for access::Const {}
 
 /// One object-dictionary entry (a VAR, or one sub-entry of an ARRAY or
 /// RECORD), implemented by a generated zero-sized type. The elements of an
@@ -443,56 +586,4 @@ impl fmt::Display for NodeId {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "{}", self.0)
     }
-}
-
-/// Whether a PDO is received or transmitted by the device.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-pub enum PdoDirection {
-    /// Received by the device (the master sends it).
-    Rpdo,
-    /// Transmitted by the device.
-    Tpdo,
-}
-
-/// A PDO frame had the wrong length for its mapping.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct PdoLengthError {
-    pub expected: usize,
-    pub actual: usize,
-}
-
-impl fmt::Display for PdoLengthError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(
-            f,
-            "PDO has {} data bytes; its mapping needs exactly {}",
-            self.actual, self.expected
-        )
-    }
-}
-
-impl core::error::Error for PdoLengthError {}
-
-/// A generated default-PDO struct.
-pub trait Pdo: Sized {
-    const DIRECTION: PdoDirection;
-    /// 1-based PDO number (TPDO1 = 1).
-    const NUMBER: u16;
-    /// Communication parameter object (0x1400.. or 0x1800..).
-    const COMMUNICATION_INDEX: u16;
-    /// Mapping parameter object (0x1600.. or 0x1A00..).
-    const MAPPING_INDEX: u16;
-    /// Data length in bytes.
-    const LEN: usize;
-    /// The mapping parameter's entries in order (`index << 16 | subindex <<
-    /// 8 | bits`), dummy entries included: what a PDO configuration writes
-    /// to sub 1.. of [`Pdo::MAPPING_INDEX`].
-    const MAPPING: &'static [u32];
-    /// The COB-ID entry's default for a node (sub 1 of
-    /// [`Pdo::COMMUNICATION_INDEX`]), when the source gives one.
-    fn default_cob_id(node_id: NodeId) -> Option<standard::PdoCobId>;
-    /// Decodes a frame's data; it must be exactly [`Pdo::LEN`] bytes.
-    fn decode(data: &[u8]) -> Result<Self, PdoLengthError>;
-    /// Encodes into the first [`Pdo::LEN`] bytes of `out`; returns that length.
-    fn encode_into(&self, out: &mut [u8; 8]) -> usize;
 }
