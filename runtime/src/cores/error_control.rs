@@ -1,7 +1,8 @@
 //! The error-control frames' common decoding (CiA 301: 0x700 + node id,
-//! one byte): boot-up, heartbeat and node-guarding replies alike. The NMT
+//! one byte): boot-up, heartbeat and node-guarding replies alike, and the
+//! NMT state they report ([`NmtState`], public as `nmt::NmtState`). The NMT
 //! master, the heartbeat consumer and node guarding all read them through
-//! [`parse_error_control`].
+//! [`parse_error_control`] and [`parse_state`].
 
 use crate::Frame;
 use crate::od::NodeId;
@@ -19,6 +20,31 @@ pub fn parse_error_control(frame: &Frame) -> Option<(NodeId, u8)> {
         [byte] => Some((node, byte)),
         _ => None,
     }
+}
+
+byte_enum! {
+    /// An NMT state as reported in boot-up, heartbeat and node-guarding frames
+    /// (bits 6..0 of the state byte; bit 7, the guarding toggle, must be
+    /// masked off before [`NmtState::from_byte`]).
+    pub enum NmtState {
+        /// The boot-up message: the node has just (re)initialised.
+        BootUp = 0x00 => "boot-up",
+        /// Stopped: only NMT and error control are active.
+        Stopped = 0x04 => "stopped",
+        /// Operational: all services, PDOs included, are active.
+        Operational = 0x05 => "operational",
+        /// Pre-operational: all services but PDOs are active.
+        PreOperational = 0x7F => "pre-operational",
+    }
+}
+
+/// Decodes an error-control frame into the node, the state it reports and
+/// the toggle bit (bit 7, node guarding's); `None` for other frames and for
+/// state bytes that are no CiA 301 state.
+pub(crate) fn parse_state(frame: &Frame) -> Option<(NodeId, NmtState, bool)> {
+    let (node, byte) = parse_error_control(frame)?;
+    let state = NmtState::from_byte(byte & 0x7F)?;
+    Some((node, state, byte & 0x80 != 0))
 }
 
 /// One optional entry per node id (1 to 127; slot 0 stays empty): what the

@@ -11,7 +11,7 @@
 use core::num::NonZeroU8;
 use core::time::Duration;
 
-use crate::error_control::{PerNode, parse_error_control};
+use crate::error_control::{PerNode, parse_state};
 use crate::frame::{CanId, cob};
 use crate::heartbeat::Liveness;
 use crate::nmt::NmtState;
@@ -180,16 +180,12 @@ impl Service for NodeGuard {
     type Event = GuardEvent;
 
     fn handle_frame(&mut self, now: Instant, frame: &Frame) {
-        let Some((node, byte)) = parse_error_control(frame) else {
-            return;
-        };
-        let Some(state) = NmtState::from_byte(byte & 0x7F) else {
+        let Some((node, state, toggle)) = parse_state(frame) else {
             return;
         };
         let Some(g) = self.nodes.get_mut(node) else {
             return;
         };
-        let toggle = byte & 0x80 != 0;
         if state == NmtState::BootUp {
             g.expected_toggle = false;
         } else if toggle != g.expected_toggle {

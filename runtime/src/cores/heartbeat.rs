@@ -28,12 +28,12 @@ pub const fn boot_up_frame(node: NodeId) -> Frame {
 }
 
 pub use crate::error_control::parse_error_control;
+use crate::error_control::parse_state;
 
 /// Decodes a heartbeat or boot-up frame into the node and its state; `None`
 /// for other frames and for state bytes that are no CiA 301 state.
 pub fn parse_heartbeat(frame: &Frame) -> Option<(NodeId, NmtState)> {
-    let (node, byte) = parse_error_control(frame)?;
-    NmtState::from_byte(byte & 0x7F).map(|state| (node, state))
+    parse_state(frame).map(|(node, state, _)| (node, state))
 }
 
 /// Heartbeat producer of one node (object 0x1017). After

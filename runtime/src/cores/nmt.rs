@@ -5,6 +5,7 @@
 use core::fmt;
 
 use crate::Frame;
+pub use crate::error_control::NmtState;
 use crate::frame::cob;
 use crate::od::NodeId;
 
@@ -35,22 +36,6 @@ impl NmtCommand {
             | NmtCommand::ResetNode
             | NmtCommand::ResetCommunication => NmtState::PreOperational,
         }
-    }
-}
-
-byte_enum! {
-    /// An NMT state as reported in boot-up, heartbeat and node-guarding frames
-    /// (bits 6..0 of the state byte; bit 7, the guarding toggle, must be
-    /// masked off before [`NmtState::from_byte`]).
-    pub enum NmtState {
-        /// The boot-up message: the node has just (re)initialised.
-        BootUp = 0x00 => "boot-up",
-        /// Stopped: only NMT and error control are active.
-        Stopped = 0x04 => "stopped",
-        /// Operational: all services, PDOs included, are active.
-        Operational = 0x05 => "operational",
-        /// Pre-operational: all services but PDOs are active.
-        PreOperational = 0x7F => "pre-operational",
     }
 }
 

@@ -4,7 +4,7 @@
 use core::fmt;
 
 use super::{NmtCommand, NmtState, NmtTarget, command_frame};
-use crate::error_control::{PerNode, parse_error_control};
+use crate::error_control::{PerNode, parse_state};
 use crate::od::NodeId;
 use crate::queue::Ring;
 use crate::{Frame, Instant, Service};
@@ -116,10 +116,7 @@ impl Service for NmtMaster {
     type Event = NmtEvent;
 
     fn handle_frame(&mut self, _now: Instant, frame: &Frame) {
-        let Some((node, byte)) = parse_error_control(frame) else {
-            return;
-        };
-        let Some(to) = NmtState::from_byte(byte & 0x7F) else {
+        let Some((node, to, _)) = parse_state(frame) else {
             return;
         };
         // After its boot-up message a node is Pre-operational by itself
