@@ -79,6 +79,19 @@ pub enum Method {
     Block,
 }
 
+impl Method {
+    /// Whether a transfer by this method is a block transfer: always with
+    /// [`Method::Block`], never with `Standard` or `Segmented`, and with
+    /// [`Method::Auto`] when `auto` (what the configuration says).
+    const fn is_block(self, auto: bool) -> bool {
+        match self {
+            Method::Block => true,
+            Method::Auto => auto,
+            Method::Standard | Method::Segmented => false,
+        }
+    }
+}
+
 /// Client settings.
 #[derive(Debug, Clone, PartialEq, Eq)]
 #[non_exhaustive]
@@ -318,23 +331,19 @@ impl SdoClient {
         method: Method,
     ) -> Result<(), Busy> {
         self.start(index, sub)?;
-        let block = match method {
-            Method::Auto => self.config.block_upload,
-            Method::Block => true,
-            Method::Standard | Method::Segmented => false,
-        };
-        if block {
-            self.send(Request::BlockUploadInitiate {
+        if method.is_block(self.config.block_upload) {
+            let (crc, block_size) = (self.config.crc, self.block_size());
+            let request = Request::BlockUploadInitiate {
                 index,
                 sub,
-                crc: self.config.crc,
-                block_size: self.block_size(),
+                crc,
+                block_size,
                 pst: 0,
-            });
-            self.wait(now, Phase::BlockUploadInitiate);
+            };
+            self.request(now, request, Phase::BlockUploadInitiate);
         } else {
-            self.send(Request::UploadInitiate { index, sub });
-            self.wait(now, Phase::UploadInitiate);
+            let request = Request::UploadInitiate { index, sub };
+            self.request(now, request, Phase::UploadInitiate);
         }
         Ok(())
     }
@@ -367,15 +376,10 @@ impl SdoClient {
             for (slot, byte) in bytes.iter_mut().zip(data) {
                 *slot = *byte;
             }
-            self.send(Request::DownloadInitiate {
-                index,
-                sub,
-                data: Initiate::Expedited {
-                    data: bytes,
-                    len: Some(size as u8),
-                },
-            });
-            self.wait(now, Phase::ExpeditedDownload { len: size as u8 });
+            let len = Some(size as u8);
+            let data = Initiate::Expedited { data: bytes, len };
+            let request = Request::DownloadInitiate { index, sub, data };
+            self.request(now, request, Phase::ExpeditedDownload { len: size as u8 });
             return Ok(());
         }
         self.out.reset(false, Some(data.len()));
@@ -420,6 +424,12 @@ impl SdoClient {
 
     fn send(&mut self, request: Request) {
         self.tx.push(request.encode());
+    }
+
+    /// Sends `request` and waits for the answer in `phase`.
+    fn request(&mut self, now: Instant, request: Request, phase: Phase) {
+        self.send(request);
+        self.wait(now, phase);
     }
 
     /// Enters `phase`, waiting for the server until `now` plus the timeout.

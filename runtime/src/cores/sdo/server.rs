@@ -325,6 +325,27 @@ impl<S: ObjectStore> SdoServer<S> {
         self.finish();
     }
 
+    /// Ends a download whose value is in the buffer: checks its length
+    /// against the announced `size`, writes it to the store, answers with
+    /// `reply` and reports it; a wrong length or a refused write aborts
+    /// instead.
+    fn complete_download(&mut self, size: Option<usize>, reply: Response) {
+        let len = self.buf.len();
+        if let Some(size) = size
+            && len != size
+        {
+            return self.fail(length_error(len, size));
+        }
+        let (index, sub) = self.object;
+        match self.store.write(index, sub, &self.buf) {
+            Ok(()) => {
+                self.send(reply);
+                self.succeed(ServerEvent::Downloaded { index, sub, len });
+            }
+            Err(code) => self.fail(code),
+        }
+    }
+
     /// A request that does not fit the current state: aborts the running
     /// transfer, or answers with an abort when there is none.
     fn reject(&mut self, code: AbortCode) {

@@ -124,11 +124,11 @@ impl SdoClient {
                 .saturating_mul(SEGMENT_BYTES)
                 .saturating_sub(self.out.fed());
             let crc = if crc { self.out.crc.value() } else { 0 };
-            self.send(Request::BlockDownloadEnd {
+            let request = Request::BlockDownloadEnd {
                 unused: unused as u8,
                 crc,
-            });
-            self.wait(now, Phase::BlockDownloadEnd);
+            };
+            self.request(now, request, Phase::BlockDownloadEnd);
             return Ok(());
         }
         let left = total.map_or(usize::MAX, |total| total.saturating_sub(confirmed));

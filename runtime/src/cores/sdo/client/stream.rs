@@ -170,29 +170,23 @@ impl SdoClient {
         size: Option<u32>,
         method: Method,
     ) {
-        let block = match method {
-            Method::Block => true,
-            Method::Auto => matches!(
-                (self.config.block_download_above, size),
-                (Some(above), Some(size)) if size as usize > above
-            ),
-            Method::Standard | Method::Segmented => false,
-        };
-        if block {
-            self.send(Request::BlockDownloadInitiate {
+        let auto = matches!(
+            (self.config.block_download_above, size),
+            (Some(above), Some(size)) if size as usize > above
+        );
+        if method.is_block(auto) {
+            let crc = self.config.crc;
+            let request = Request::BlockDownloadInitiate {
                 index,
                 sub,
-                crc: self.config.crc,
+                crc,
                 size,
-            });
-            self.wait(now, Phase::BlockDownloadInitiate);
+            };
+            self.request(now, request, Phase::BlockDownloadInitiate);
         } else {
-            self.send(Request::DownloadInitiate {
-                index,
-                sub,
-                data: Initiate::Segmented { size },
-            });
-            self.wait(now, Phase::DownloadInitiate);
+            let data = Initiate::Segmented { size };
+            let request = Request::DownloadInitiate { index, sub, data };
+            self.request(now, request, Phase::DownloadInitiate);
         }
     }
 

@@ -3,7 +3,7 @@
 use super::super::proto::{BlockSegment, CRC, Request, Response};
 use super::{
     MAX_BLOCK_SIZE, ObjectStore, SEGMENT, SdoServer, ServerEvent, State, append_bounded,
-    length_error, offered_block_size, padded_len, segment_error,
+    offered_block_size, padded_len, segment_error,
 };
 use crate::sdo::AbortCode;
 
@@ -209,19 +209,7 @@ impl<S: ObjectStore> SdoServer<S> {
         if agreed_crc && CRC.checksum(&self.buf) != crc {
             return self.fail(AbortCode::CrcError);
         }
-        if let Some(size) = size
-            && len != size
-        {
-            return self.fail(length_error(len, size));
-        }
-        let (index, sub) = self.object;
-        match self.store.write(index, sub, &self.buf) {
-            Ok(()) => {
-                self.send(Response::BlockDownloadEnd);
-                self.succeed(ServerEvent::Downloaded { index, sub, len });
-            }
-            Err(code) => self.fail(code),
-        }
+        self.complete_download(size, Response::BlockDownloadEnd);
     }
 
     /// Block upload initiate: checks the client's block size, reads the

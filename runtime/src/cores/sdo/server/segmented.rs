@@ -2,7 +2,7 @@
 //! upload" protocols).
 
 use super::super::proto::{Initiate, Response};
-use super::{ObjectStore, SEGMENT, SdoServer, ServerEvent, State, append_bounded, length_error};
+use super::{ObjectStore, SEGMENT, SdoServer, ServerEvent, State, append_bounded};
 use crate::sdo::AbortCode;
 
 impl<S: ObjectStore> SdoServer<S> {
@@ -83,20 +83,7 @@ impl<S: ObjectStore> SdoServer<S> {
             self.send(Response::DownloadSegment { toggle });
             return;
         }
-        let len = self.buf.len();
-        if let Some(size) = size
-            && len != size
-        {
-            return self.fail(length_error(len, size));
-        }
-        let (index, sub) = self.object;
-        match self.store.write(index, sub, &self.buf) {
-            Ok(()) => {
-                self.send(Response::DownloadSegment { toggle });
-                self.succeed(ServerEvent::Downloaded { index, sub, len });
-            }
-            Err(code) => self.fail(code),
-        }
+        self.complete_download(size, Response::DownloadSegment { toggle });
     }
 
     /// Upload initiate: reads the value; up to 4 bytes go expedited, more
