@@ -389,7 +389,7 @@ impl SdoClient {
         }
         self.out.push(data);
         self.out.ended = true;
-        self.initiate_download(now, index, sub, Some(size), method);
+        self.initiate_download(now, Some(size), method);
         Ok(())
     }
 
@@ -440,6 +440,16 @@ impl SdoClient {
 
     fn is_ours(&self, index: u16, sub: u8) -> bool {
         index == self.index && sub == self.sub
+    }
+
+    /// An answer about (index, sub): `Ok` when that is the object of the
+    /// transfer, else the transfer ends (ParameterIncompatible).
+    fn check_ours(&mut self, index: u16, sub: u8) -> Result<(), Ended> {
+        if self.is_ours(index, sub) {
+            Ok(())
+        } else {
+            Err(self.fail(AbortCode::ParameterIncompatible))
+        }
     }
 
     /// Ends the transfer: sends abort `code` and reports `LocalAbort(code)`.

@@ -80,9 +80,7 @@ impl SdoClient {
         crc: bool,
         block_size: u8,
     ) -> Result<(), Ended> {
-        if !self.is_ours(index, sub) {
-            return Err(self.fail(AbortCode::ParameterIncompatible));
-        }
+        self.check_ours(index, sub)?;
         self.start_sub_block(now, crc && self.config.crc, 0, block_size)
     }
 
@@ -181,9 +179,7 @@ impl SdoClient {
         crc: bool,
         size: Option<u32>,
     ) -> Result<(), Ended> {
-        if !self.is_ours(index, sub) {
-            return Err(self.fail(AbortCode::ParameterIncompatible));
-        }
+        self.check_ours(index, sub)?;
         let size = self.reserve_announced(size)?;
         self.send(Request::BlockUploadStart);
         self.wait(

@@ -155,21 +155,15 @@ impl SdoClient {
     ) -> Result<(), Busy> {
         self.start(index, sub)?;
         self.out.reset(true, size.map(|s| s as usize));
-        self.initiate_download(now, index, sub, size, method);
+        self.initiate_download(now, size, method);
         Ok(())
     }
 
     /// Sends the initiate of a segmented or block download (of the value in
     /// `self.out`): block with [`Method::Block`], or with [`Method::Auto`]
     /// when `block_download_above` is below the size.
-    pub(super) fn initiate_download(
-        &mut self,
-        now: Instant,
-        index: u16,
-        sub: u8,
-        size: Option<u32>,
-        method: Method,
-    ) {
+    pub(super) fn initiate_download(&mut self, now: Instant, size: Option<u32>, method: Method) {
+        let (index, sub) = (self.index, self.sub);
         let auto = matches!(
             (self.config.block_download_above, size),
             (Some(above), Some(size)) if size as usize > above
