@@ -253,22 +253,18 @@ fn store_configuration() {
 fn inquire_identity_answers_each_part() {
     let mut s = slave(node(1));
     send(&mut s, GLOBAL_CONFIG);
-    assert_eq!(
-        send(&mut s, [0x5A, 0, 0, 0, 0, 0, 0, 0]),
-        [[0x5A, 0x7A, 0x01, 0, 0, 0, 0, 0]]
-    );
-    assert_eq!(
-        send(&mut s, [0x5B, 0, 0, 0, 0, 0, 0, 0]),
-        [[0x5B, 0x01, 0x20, 0, 0, 0, 0, 0]]
-    );
-    assert_eq!(
-        send(&mut s, [0x5C, 0, 0, 0, 0, 0, 0, 0]),
-        [[0x5C, 0x01, 0, 0x03, 0, 0, 0, 0]]
-    );
-    assert_eq!(
-        send(&mut s, [0x5D, 0, 0, 0, 0, 0, 0, 0]),
-        [[0x5D, 0x34, 0x12, 0, 0, 0, 0, 0]]
-    );
+    for (cs, answer) in [
+        (0x5A, [0x7A, 0x01, 0, 0]),
+        (0x5B, [0x01, 0x20, 0, 0]),
+        (0x5C, [0x01, 0, 0x03, 0]),
+        (0x5D, [0x34, 0x12, 0, 0]),
+    ] {
+        let [a, b, c, d] = answer;
+        assert_eq!(
+            send(&mut s, [cs, 0, 0, 0, 0, 0, 0, 0]),
+            [[cs, a, b, c, d, 0, 0, 0]]
+        );
+    }
 }
 
 /// The six identify remote slave frames (0x46..=0x4B) for a range.
