@@ -109,22 +109,26 @@ fn master_outbox_is_bounded() {
     assert_eq!(core::iter::from_fn(|| m.poll_transmit()).count(), 16);
 }
 
+/// What the master reports of node `n`'s boot-up message when it last
+/// reported `from`: the boot-up, then the change to Pre-operational.
+fn booted_up(n: u8, from: Option<NmtState>) -> Vec<NmtEvent> {
+    let to = NmtState::PreOperational;
+    vec![
+        NmtEvent::BootUp(node(n)),
+        NmtEvent::StateChanged {
+            node: node(n),
+            from,
+            to,
+        },
+    ]
+}
+
 #[test]
 fn master_tracks_boot_up_and_heartbeats() {
     let mut m = NmtMaster::new();
     let t = Instant::ZERO;
     m.handle_frame(t, &data(0x720, &[0x00]));
-    assert_eq!(
-        events(&mut m),
-        [
-            NmtEvent::BootUp(node(32)),
-            NmtEvent::StateChanged {
-                node: node(32),
-                from: None,
-                to: NmtState::PreOperational
-            }
-        ]
-    );
+    assert_eq!(events(&mut m), booted_up(32, None));
     // Pre-operational after the boot-up message, as CiA 301 has it:
     // its first heartbeat changes nothing.
     assert_eq!(m.state(node(32)), Some(NmtState::PreOperational));
@@ -148,18 +152,9 @@ fn master_tracks_boot_up_and_heartbeats() {
     // A second boot-up is reported even after another boot-up.
     m.handle_frame(t, &data(0x720, &[0x00]));
     m.handle_frame(t, &data(0x720, &[0x00]));
-    assert_eq!(
-        events(&mut m),
-        [
-            NmtEvent::BootUp(node(32)),
-            NmtEvent::StateChanged {
-                node: node(32),
-                from: Some(NmtState::Operational),
-                to: NmtState::PreOperational
-            },
-            NmtEvent::BootUp(node(32)),
-        ]
-    );
+    let mut twice = booted_up(32, Some(NmtState::Operational));
+    twice.push(NmtEvent::BootUp(node(32)));
+    assert_eq!(events(&mut m), twice);
 }
 
 #[test]
