@@ -325,6 +325,20 @@ impl<S: ObjectStore> SdoServer<S> {
         self.finish();
     }
 
+    /// The size a download initiate announced, checked: within
+    /// `max_download` (else OutOfMemory) and accepted by the store for the
+    /// object (else the store's abort code).
+    fn download_size(&mut self, size: Option<u32>) -> Result<Option<usize>, AbortCode> {
+        let size = match size.map(usize::try_from) {
+            None => None,
+            Some(Ok(size)) if size <= self.config.max_download => Some(size),
+            Some(_) => return Err(AbortCode::OutOfMemory),
+        };
+        let (index, sub) = self.object;
+        self.store.check_write(index, sub, size)?;
+        Ok(size)
+    }
+
     /// Ends a download whose value is in the buffer: checks its length
     /// against the announced `size`, writes it to the store, answers with
     /// `reply` and reports it; a wrong length or a refused write aborts

@@ -117,15 +117,11 @@ impl<S: ObjectStore> SdoServer<S> {
     /// Block download initiate: checks the size bound and the store, then
     /// offers the block size and the CRC.
     pub(super) fn block_download_initiate(&mut self, crc: bool, size: Option<u32>) {
-        let (index, sub) = self.object;
-        let size = match size.map(usize::try_from) {
-            None => None,
-            Some(Ok(size)) if size <= self.config.max_download => Some(size),
-            Some(_) => return self.fail(AbortCode::OutOfMemory),
+        let size = match self.download_size(size) {
+            Ok(size) => size,
+            Err(code) => return self.fail(code),
         };
-        if let Err(code) = self.store.check_write(index, sub, size) {
-            return self.fail(code);
-        }
+        let (index, sub) = self.object;
         let limit = padded_len(size.unwrap_or(self.config.max_download));
         if size.is_some() {
             self.buf.reserve_exact(limit);

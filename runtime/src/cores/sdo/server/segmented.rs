@@ -31,14 +31,10 @@ impl<S: ObjectStore> SdoServer<S> {
                 }
             }
             Initiate::Segmented { size } => {
-                let size = match size.map(usize::try_from) {
-                    None => None,
-                    Some(Ok(size)) if size <= self.config.max_download => Some(size),
-                    Some(_) => return self.fail(AbortCode::OutOfMemory),
+                let size = match self.download_size(size) {
+                    Ok(size) => size,
+                    Err(code) => return self.fail(code),
                 };
-                if let Err(code) = self.store.check_write(index, sub, size) {
-                    return self.fail(code);
-                }
                 if let Some(size) = size {
                     self.buf.reserve_exact(size);
                 }
