@@ -176,6 +176,18 @@ impl fmt::Display for ParseError {
 }
 
 impl Request {
+    /// The object whose transfer an initiate request starts; `None` for
+    /// other requests.
+    pub(crate) fn initiated_object(&self) -> Option<(u16, u8)> {
+        match *self {
+            Request::DownloadInitiate { index, sub, .. }
+            | Request::UploadInitiate { index, sub }
+            | Request::BlockDownloadInitiate { index, sub, .. }
+            | Request::BlockUploadInitiate { index, sub, .. } => Some((index, sub)),
+            _ => None,
+        }
+    }
+
     pub fn parse(data: &[u8]) -> Result<Request, ParseError> {
         let d = eight(data)?;
         let b = d[0];

@@ -398,35 +398,19 @@ impl<S: ObjectStore> SdoServer<S> {
 
     /// Dispatches one parsed request.
     fn handle_request(&mut self, request: Request) {
+        if let Some((index, sub)) = request.initiated_object() {
+            self.begin(index, sub);
+        }
         match request {
             Request::Abort { code, .. } => self.remote_abort(code),
-            Request::DownloadInitiate { index, sub, data } => {
-                self.begin(index, sub);
-                self.download_initiate(data);
-            }
-            Request::UploadInitiate { index, sub } => {
-                self.begin(index, sub);
-                self.upload_initiate();
-            }
-            Request::BlockDownloadInitiate {
-                index,
-                sub,
-                crc,
-                size,
-            } => {
-                self.begin(index, sub);
+            Request::DownloadInitiate { data, .. } => self.download_initiate(data),
+            Request::UploadInitiate { .. } => self.upload_initiate(),
+            Request::BlockDownloadInitiate { crc, size, .. } => {
                 self.block_download_initiate(crc, size);
             }
             Request::BlockUploadInitiate {
-                index,
-                sub,
-                crc,
-                block_size,
-                pst: _,
-            } => {
-                self.begin(index, sub);
-                self.block_upload_initiate(crc, block_size);
-            }
+                crc, block_size, ..
+            } => self.block_upload_initiate(crc, block_size),
             Request::DownloadSegment {
                 toggle,
                 last,
