@@ -60,6 +60,46 @@ macro_rules! byte_enum {
     };
 }
 
+/// A public enum of consecutive indices from 0: the enum (`#[repr(u8)]`),
+/// `ALL` (every value, in index order; its doc given) and `from_index`
+/// (`None` past the last), written once for the parts of an LSS address
+/// and the frames of identify remote slave.
+macro_rules! indexed_enum {
+    (
+        $(#[$meta:meta])*
+        pub enum $name:ident {
+            $($(#[$vmeta:meta])* $variant:ident = $index:literal,)+
+        }
+        $(#[$all_meta:meta])*
+        ALL;
+    ) => {
+        $(#[$meta])*
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+        #[repr(u8)]
+        pub enum $name {
+            $($(#[$vmeta])* $variant = $index,)+
+        }
+
+        impl $name {
+            $(#[$all_meta])*
+            pub const ALL: [$name; [$($index),+].len()] = [$($name::$variant),+];
+
+            /// The value with index `index`; `None` for other values.
+            pub const fn from_index(index: u8) -> Option<$name> {
+                match index {
+                    $($index => Some($name::$variant),)+
+                    _ => None,
+                }
+            }
+
+            /// The index.
+            pub const fn index(self) -> u8 {
+                self as u8
+            }
+        }
+    };
+}
+
 #[cfg(feature = "alloc")]
 pub mod boot;
 pub mod cia402;

@@ -91,45 +91,21 @@ byte_enum! {
     }
 }
 
-/// One of the four parts of an LSS address; its index (0 to 3) is the
-/// `LSSSub` of fastscan and the sub-index of object 0x1018 minus one.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[repr(u8)]
-pub enum IdentityField {
-    /// Vendor id (0x1018:01).
-    VendorId = 0,
-    /// Product code (0x1018:02).
-    ProductCode = 1,
-    /// Revision number (0x1018:03).
-    Revision = 2,
-    /// Serial number (0x1018:04).
-    Serial = 3,
-}
-
-impl IdentityField {
+indexed_enum! {
+    /// One of the four parts of an LSS address; its index (0 to 3) is the
+    /// `LSSSub` of fastscan and the sub-index of object 0x1018 minus one.
+    pub enum IdentityField {
+        /// Vendor id (0x1018:01).
+        VendorId = 0,
+        /// Product code (0x1018:02).
+        ProductCode = 1,
+        /// Revision number (0x1018:03).
+        Revision = 2,
+        /// Serial number (0x1018:04).
+        Serial = 3,
+    }
     /// All fields, in LSS address order.
-    pub const ALL: [IdentityField; 4] = [
-        IdentityField::VendorId,
-        IdentityField::ProductCode,
-        IdentityField::Revision,
-        IdentityField::Serial,
-    ];
-
-    /// The field with index `index` (0 to 3); `None` for other values.
-    pub const fn from_index(index: u8) -> Option<IdentityField> {
-        match index {
-            0 => Some(IdentityField::VendorId),
-            1 => Some(IdentityField::ProductCode),
-            2 => Some(IdentityField::Revision),
-            3 => Some(IdentityField::Serial),
-            _ => None,
-        }
-    }
-
-    /// The index, 0 to 3.
-    pub const fn index(self) -> u8 {
-        self as u8
-    }
+    ALL;
 }
 
 /// An LSS address: the four entries of the identity object 0x1018.

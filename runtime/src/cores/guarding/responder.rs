@@ -78,7 +78,7 @@ impl GuardResponder {
     }
 
     /// Sets the life time (objects 0x100C guard time × 0x100D life time
-    /// factor, see [`life_time`]); `None` switches life guarding off.
+    /// factor, see [`life_time`](super::life_time)); `None` switches life guarding off.
     /// Supervision (re)starts with the next request.
     pub fn set_life_time(&mut self, life_time: Option<Duration>) {
         self.life = life_time.map(|time| Liveness::new(time, None));
