@@ -285,7 +285,7 @@ impl Service for SyncConsumer {
 mod tests {
     use super::*;
     use crate::CanId;
-    use crate::cores::testing::{data, events, frames, ms};
+    use crate::cores::testing::{assert_due, data, events, frames, ms};
 
     #[test]
     fn frames_without_counter() {
@@ -293,11 +293,7 @@ mod tests {
         assert_eq!(p.poll_timeout(), None);
         p.start(ms(100));
         assert!(frames(&mut p).is_empty());
-        assert_eq!(p.poll_timeout(), Some(ms(110)));
-        p.handle_timeout(ms(109));
-        assert!(frames(&mut p).is_empty());
-        p.handle_timeout(ms(110));
-        assert_eq!(frames(&mut p), [data(0x080, &[])]);
+        assert_due(&mut p, 110, &[data(0x080, &[])]);
         assert_eq!(frames(&mut p)[..], []);
         assert_eq!(p.poll_timeout(), Some(ms(120)));
     }

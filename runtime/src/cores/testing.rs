@@ -33,3 +33,13 @@ pub(crate) fn frames<S: Service>(s: &mut S) -> Vec<Frame> {
 pub(crate) fn events<S: Service>(s: &mut S) -> Vec<S::Event> {
     core::iter::from_fn(|| s.poll_event()).collect()
 }
+
+/// `s` is due at `due` ms: it says so, has nothing to send a millisecond
+/// before, and sends `sent` at `due`.
+pub(crate) fn assert_due<S: Service>(s: &mut S, due: u64, sent: &[Frame]) {
+    assert_eq!(s.poll_timeout(), Some(ms(due)));
+    s.handle_timeout(ms(due - 1));
+    assert!(frames(s).is_empty());
+    s.handle_timeout(ms(due));
+    assert_eq!(frames(s), sent);
+}

@@ -1,6 +1,6 @@
 use super::*;
 use crate::CanId;
-use crate::cores::testing::{data, events, frames, ms, node};
+use crate::cores::testing::{assert_due, data, events, frames, ms, node};
 
 #[test]
 fn frame_layouts() {
@@ -39,11 +39,7 @@ fn producer_sends_boot_up_then_periodic_heartbeats() {
     assert!(frames(&mut p).is_empty());
     p.start(ms(1000));
     assert_eq!(frames(&mut p), [data(0x720, &[0x00])]);
-    assert_eq!(p.poll_timeout(), Some(ms(1100)));
-    p.handle_timeout(ms(1099));
-    assert!(frames(&mut p).is_empty());
-    p.handle_timeout(ms(1100));
-    assert_eq!(frames(&mut p), [data(0x720, &[0x7F])]);
+    assert_due(&mut p, 1100, &[data(0x720, &[0x7F])]);
     assert_eq!(p.poll_timeout(), Some(ms(1200)));
     p.set_state(NmtState::Operational);
     // Handled a little late: the schedule does not drift.

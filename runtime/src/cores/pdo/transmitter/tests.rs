@@ -1,7 +1,7 @@
 use super::*;
 use crate::CanId;
 use crate::cores::pdo::test_pdos::Command;
-use crate::cores::testing::{data, ms};
+use crate::cores::testing::{assert_due, data, ms};
 use crate::od::NodeId;
 
 fn us(n: u64) -> Instant {
@@ -199,11 +199,7 @@ fn event_timer_resends_without_events() {
     assert_eq!(t.poll_timeout(), None, "no data yet");
     t.set_data(ms(0), &[7]).unwrap();
     assert_eq!(frames(&mut t), [data(0x201, &[7])]);
-    assert_eq!(t.poll_timeout(), Some(ms(100)));
-    t.handle_timeout(ms(99));
-    assert!(frames(&mut t).is_empty());
-    t.handle_timeout(ms(100));
-    assert_eq!(frames(&mut t), [data(0x201, &[7])]);
+    assert_due(&mut t, 100, &[data(0x201, &[7])]);
     assert_eq!(t.poll_timeout(), Some(ms(200)));
     t.handle_timeout(ms(200));
     assert_eq!(frames(&mut t), [data(0x201, &[7])]);
