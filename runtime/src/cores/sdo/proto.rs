@@ -178,6 +178,7 @@ impl fmt::Display for ParseError {
 impl Request {
     /// The object whose transfer an initiate request starts; `None` for
     /// other requests.
+    #[cfg(feature = "alloc")]
     pub(crate) fn initiated_object(&self) -> Option<(u16, u8)> {
         match *self {
             Request::DownloadInitiate { index, sub, .. }
