@@ -3,8 +3,8 @@
 //!
 //! Expedited, segmented and block transfers in both directions; every frame
 //! is built and parsed by [`super::proto`]. The client sends on
-//! [`Channel::request`] and listens only to data frames on
-//! [`Channel::response`] (11- or 29-bit, as the channel says); it ignores
+//! [`Channel::request`](super::Channel::request) and listens only to data frames on
+//! [`Channel::response`](super::Channel::response) (11- or 29-bit, as the channel says); it ignores
 //! everything else, and every frame while idle.
 //!
 //! Each step waits [`ClientConfig::timeout`] for the server's next frame. A
@@ -31,6 +31,7 @@
 //! [`SdoError::RemoteAbort`] and nothing is sent.
 
 mod block;
+mod config;
 mod segmented;
 mod service;
 mod stream;
@@ -40,16 +41,16 @@ mod tests;
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 use core::mem;
-use core::time::Duration;
 
 use super::proto::{Initiate, Request, Response};
-use super::{AbortCode, Channel, DEFAULT_TIMEOUT, MAX_BLOCK_SIZE, SdoError};
+use super::{AbortCode, MAX_BLOCK_SIZE, SdoError};
 use crate::Instant;
 #[cfg(doc)]
 use crate::Service;
 
 use crate::queue::Ring;
 use block::{DownloadBlock, UploadBlock};
+pub use config::{ClientConfig, Method};
 pub use stream::WINDOW;
 use stream::{Crc16, Outgoing};
 
@@ -61,80 +62,6 @@ const SEGMENT_BYTES: usize = 7;
 /// Events the client holds for [`Service::poll_event`]; starting a transfer
 /// while this many wait is refused with [`Busy`].
 pub const MAX_PENDING_EVENTS: usize = 8;
-
-/// How a transfer is carried out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Method {
-    /// Downloads: expedited up to 4 bytes, block above
-    /// [`ClientConfig::block_download_above`] (when set), segmented otherwise.
-    /// Uploads: block when [`ClientConfig::block_upload`], else standard.
-    #[default]
-    Auto,
-    /// The standard protocol: expedited when the data fits 4 bytes (the
-    /// server decides for uploads), segmented otherwise.
-    Standard,
-    /// Segmented even for 4 bytes or less (downloads; uploads as Standard).
-    Segmented,
-    /// Block transfer.
-    Block,
-}
-
-impl Method {
-    /// Whether a transfer by this method is a block transfer: always with
-    /// [`Method::Block`], never with `Standard` or `Segmented`, and with
-    /// [`Method::Auto`] when `auto` (what the configuration says).
-    const fn is_block(self, auto: bool) -> bool {
-        match self {
-            Method::Block => true,
-            Method::Auto => auto,
-            Method::Standard | Method::Segmented => false,
-        }
-    }
-}
-
-/// Client settings.
-#[derive(Debug, Clone, PartialEq, Eq)]
-#[non_exhaustive]
-pub struct ClientConfig {
-    /// The COB-IDs the client sends requests on and receives responses from.
-    pub channel: Channel,
-    /// Time the server has to answer each frame.
-    pub timeout: Duration,
-    /// Block size asked for in block uploads (1 to 127; other values are
-    /// clamped into that range).
-    pub block_size: u8,
-    /// Offer CRC in block transfers.
-    pub crc: bool,
-    /// Largest upload accepted; a server announcing more gets abort
-    /// 0x05040005 (out of memory) before anything is allocated.
-    pub max_upload: usize,
-    /// Use block download (with [`Method::Auto`]) above this many bytes.
-    pub block_download_above: Option<usize>,
-    /// Use block upload with [`Method::Auto`].
-    pub block_upload: bool,
-    /// Typed reads refuse a value longer than the entry's data type (a
-    /// device answering 4 bytes for an UNSIGNED8) with a length error,
-    /// instead of taking its leading bytes and leaving a
-    /// [`LengthNote`](super::typed::LengthNote).
-    pub strict_lengths: bool,
-}
-
-impl ClientConfig {
-    /// Defaults: 500 ms timeout, block size 127, CRC offered, uploads up to
-    /// 1 MiB, no block transfers with [`Method::Auto`].
-    pub fn new(channel: Channel) -> ClientConfig {
-        ClientConfig {
-            channel,
-            timeout: DEFAULT_TIMEOUT,
-            block_size: super::MAX_BLOCK_SIZE,
-            crc: true,
-            max_upload: 1 << 20,
-            block_download_above: None,
-            block_upload: false,
-            strict_lengths: false,
-        }
-    }
-}
 
 /// The client is already running a transfer (or holds
 /// [`MAX_PENDING_EVENTS`] events the caller has not polled).

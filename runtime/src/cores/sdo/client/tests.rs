@@ -8,8 +8,10 @@ mod stream;
 
 use super::*;
 use crate::frame::CanId;
+use crate::sdo::Channel;
 use crate::sdo::proto::ParseError;
 use crate::{Frame, Service};
+use core::time::Duration;
 
 const REQUEST: u16 = 0x601;
 const RESPONSE: u16 = 0x581;
