@@ -61,16 +61,33 @@ pub use time_stamp::{TimeDifference, TimeOfDay};
 ///
 /// Cores ignore frames that are not theirs, so a driver may feed every frame
 /// on the bus to every core.
+///
+/// Only [`Service::handle_frame`] must be written; the other methods'
+/// defaults are those of a core without that side (no timers, nothing to
+/// send, no events), so a core that only listens, or only sends, says just
+/// what it does.
 pub trait Service {
     type Event;
     /// A frame was received at `now`.
     fn handle_frame(&mut self, now: Instant, frame: &Frame);
     /// The clock reached (or passed) the deadline of [`Service::poll_timeout`].
-    fn handle_timeout(&mut self, now: Instant);
+    /// Default: nothing happens (no timers).
+    fn handle_timeout(&mut self, now: Instant) {
+        let _ = now;
+    }
     /// The next frame to send, if any. Call until `None` after every input.
-    fn poll_transmit(&mut self) -> Option<Frame>;
+    /// Default: `None` (the core never sends).
+    fn poll_transmit(&mut self) -> Option<Frame> {
+        None
+    }
     /// The next event, if any. Call until `None` after every input.
-    fn poll_event(&mut self) -> Option<Self::Event>;
+    /// Default: `None` (the core reports nothing).
+    fn poll_event(&mut self) -> Option<Self::Event> {
+        None
+    }
     /// The earliest instant at which [`Service::handle_timeout`] must be called.
-    fn poll_timeout(&self) -> Option<Instant>;
+    /// Default: `None` (no timers).
+    fn poll_timeout(&self) -> Option<Instant> {
+        None
+    }
 }

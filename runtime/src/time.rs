@@ -159,6 +159,102 @@ pub fn earliest(a: Option<Instant>, b: Option<Instant>) -> Option<Instant> {
     }
 }
 
+/// The next deadline of a periodic task due at `due`, handled at `now`:
+/// one period after `due`, or one period after `now` if that is already
+/// past (the clock jumped; missed periods are skipped, not caught up).
+pub(crate) fn next_period(due: Instant, now: Instant, period: Duration) -> Instant {
+    let next = due + period;
+    if next > now { next } else { now + period }
+}
+
+/// A period raised to `min` (a zero one would be due again at once, for
+/// ever): what the producers do with a `Some` period shorter than the unit
+/// of their object.
+const fn at_least(period: Option<Duration>, min: Duration) -> Option<Duration> {
+    match period {
+        Some(p) if p.as_nanos() < min.as_nanos() => Some(min),
+        other => other,
+    }
+}
+
+/// The schedule of a periodic producer (heartbeat, SYNC, TIME): its period
+/// (`None`: nothing periodic; a `Some` below the unit of its object counts
+/// as that unit), whether it was started, and when it is next due. A jump
+/// of the clock over several periods gives one due period, and the next one
+/// period after `now` (see [`next_period`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Periodic {
+    period: Option<Duration>,
+    min: Duration,
+    running: bool,
+    next: Option<Instant>,
+}
+
+impl Periodic {
+    /// A stopped schedule with `period`, raised to `min`.
+    pub(crate) const fn new(period: Option<Duration>, min: Duration) -> Periodic {
+        Periodic {
+            period: at_least(period, min),
+            min,
+            running: false,
+            next: None,
+        }
+    }
+
+    /// The period (`None`: nothing periodic).
+    pub(crate) const fn period(&self) -> Option<Duration> {
+        self.period
+    }
+
+    /// Whether the schedule was started (and not stopped).
+    pub(crate) const fn is_running(&self) -> bool {
+        self.running
+    }
+
+    /// When the next period is due; `None` when stopped or without a period.
+    pub(crate) const fn next(&self) -> Option<Instant> {
+        self.next
+    }
+
+    /// Starts (or restarts): the first period is due one period after `now`.
+    pub(crate) fn start(&mut self, now: Instant) {
+        self.running = true;
+        self.next = self.period.map(|period| now + period);
+    }
+
+    /// Starts (or restarts) with the first period due at `now`.
+    pub(crate) fn start_at_once(&mut self, now: Instant) {
+        self.running = true;
+        self.next = self.period.map(|_| now);
+    }
+
+    /// Stops: nothing is due until the next start.
+    pub(crate) fn stop(&mut self) {
+        self.running = false;
+        self.next = None;
+    }
+
+    /// Changes the period; when running, the next one is due one new period
+    /// after `now` (`None` pauses, a later period resumes).
+    pub(crate) fn set_period(&mut self, now: Instant, period: Option<Duration>) {
+        self.period = at_least(period, self.min);
+        if self.running {
+            self.next = self.period.map(|period| now + period);
+        }
+    }
+
+    /// Whether a period is due at `now`; if so the next one is scheduled.
+    pub(crate) fn fire(&mut self, now: Instant) -> bool {
+        match self.next {
+            Some(due) if due <= now => {
+                self.next = self.period.map(|period| next_period(due, now, period));
+                true
+            }
+            _ => false,
+        }
+    }
+}
+
 /// The point in time until which a driver call may wait, on the driver's
 /// clock.
 ///

@@ -238,11 +238,7 @@ pub struct EmcyConsumer {
     events: Ring<EmcyEvent, CONSUMER_EVENTS>,
 }
 
-impl Default for EmcyConsumer {
-    fn default() -> Self {
-        EmcyConsumer::new()
-    }
-}
+default_is_new!(EmcyConsumer);
 
 impl EmcyConsumer {
     /// A consumer watching all nodes 1 to 127.
@@ -310,18 +306,8 @@ impl Service for EmcyConsumer {
         });
     }
 
-    fn handle_timeout(&mut self, _now: Instant) {}
-
-    fn poll_transmit(&mut self) -> Option<Frame> {
-        None
-    }
-
     fn poll_event(&mut self) -> Option<EmcyEvent> {
         self.events.pop()
-    }
-
-    fn poll_timeout(&self) -> Option<Instant> {
-        None
     }
 }
 
@@ -329,18 +315,7 @@ impl Service for EmcyConsumer {
 mod tests {
     use super::*;
     use crate::CanId;
-
-    fn node(n: u8) -> NodeId {
-        NodeId::new(n).unwrap()
-    }
-
-    fn data(id: u16, bytes: &[u8]) -> Frame {
-        Frame::new(CanId::Standard(id), bytes).unwrap()
-    }
-
-    fn events<S: Service>(s: &mut S) -> Vec<S::Event> {
-        core::iter::from_fn(|| s.poll_event()).collect()
-    }
+    use crate::cores::testing::{data, events, node};
 
     #[test]
     fn parse_cia301_layout() {

@@ -81,80 +81,31 @@ pub const ERROR_STORAGE_ACCESS: u8 = 2;
 /// reason is in the spec error byte.
 pub const ERROR_IMPLEMENTATION_SPECIFIC: u8 = 0xFF;
 
-/// The state of an LSS slave, also the mode byte of switch state global.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[repr(u8)]
-pub enum LssState {
-    /// Waiting: only switch services, identification and fastscan apply.
-    Waiting = 0,
-    /// Configuration: node id, bit timing, store and inquiry services apply.
-    Configuration = 1,
-}
-
-impl LssState {
-    /// The state with mode byte `byte`; `None` for other values.
-    pub const fn from_byte(byte: u8) -> Option<LssState> {
-        match byte {
-            0 => Some(LssState::Waiting),
-            1 => Some(LssState::Configuration),
-            _ => None,
-        }
-    }
-
-    /// The mode byte.
-    pub const fn to_byte(self) -> u8 {
-        self as u8
+byte_enum! {
+    /// The state of an LSS slave, also the mode byte of switch state global.
+    pub enum LssState {
+        /// Waiting: only switch services, identification and fastscan apply.
+        Waiting = 0 => "waiting",
+        /// Configuration: node id, bit timing, store and inquiry services apply.
+        Configuration = 1 => "configuration",
     }
 }
 
-impl fmt::Display for LssState {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(match self {
-            LssState::Waiting => "waiting",
-            LssState::Configuration => "configuration",
-        })
+indexed_enum! {
+    /// One of the four parts of an LSS address; its index (0 to 3) is the
+    /// `LSSSub` of fastscan and the sub-index of object 0x1018 minus one.
+    pub enum IdentityField {
+        /// Vendor id (0x1018:01).
+        VendorId = 0,
+        /// Product code (0x1018:02).
+        ProductCode = 1,
+        /// Revision number (0x1018:03).
+        Revision = 2,
+        /// Serial number (0x1018:04).
+        Serial = 3,
     }
-}
-
-/// One of the four parts of an LSS address; its index (0 to 3) is the
-/// `LSSSub` of fastscan and the sub-index of object 0x1018 minus one.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[repr(u8)]
-pub enum IdentityField {
-    /// Vendor id (0x1018:01).
-    VendorId = 0,
-    /// Product code (0x1018:02).
-    ProductCode = 1,
-    /// Revision number (0x1018:03).
-    Revision = 2,
-    /// Serial number (0x1018:04).
-    Serial = 3,
-}
-
-impl IdentityField {
     /// All fields, in LSS address order.
-    pub const ALL: [IdentityField; 4] = [
-        IdentityField::VendorId,
-        IdentityField::ProductCode,
-        IdentityField::Revision,
-        IdentityField::Serial,
-    ];
-
-    /// The field with index `index` (0 to 3); `None` for other values.
-    pub const fn from_index(index: u8) -> Option<IdentityField> {
-        match index {
-            0 => Some(IdentityField::VendorId),
-            1 => Some(IdentityField::ProductCode),
-            2 => Some(IdentityField::Revision),
-            3 => Some(IdentityField::Serial),
-            _ => None,
-        }
-    }
-
-    /// The index, 0 to 3.
-    pub const fn index(self) -> u8 {
-        self as u8
-    }
+    ALL;
 }
 
 /// An LSS address: the four entries of the identity object 0x1018.

@@ -26,6 +26,8 @@ pub mod derive;
 mod error;
 pub mod layout;
 mod receiver;
+#[cfg(test)]
+mod test_pdos;
 mod transmitter;
 
 #[cfg(feature = "std")]

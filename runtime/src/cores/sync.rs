@@ -10,8 +10,8 @@ use core::fmt;
 use core::time::Duration;
 
 use crate::frame::cob;
-use crate::heartbeat::{at_least, next_period};
 use crate::queue::Ring;
+use crate::time::Periodic;
 use crate::{Frame, Instant, Service};
 
 /// The shortest SYNC period: 1 µs, the unit of object 0x1006.
@@ -85,11 +85,9 @@ pub fn parse_sync(frame: &Frame) -> Option<Option<u8>> {
 #[derive(Debug, Clone)]
 pub struct SyncProducer {
     cob_id: u16,
-    period: Option<Duration>,
+    schedule: Periodic,
     overflow: Option<u8>,
     counter: u8,
-    running: bool,
-    next: Option<Instant>,
     pending: bool,
 }
 
@@ -119,11 +117,9 @@ impl SyncProducer {
         }
         Ok(SyncProducer {
             cob_id,
-            period: at_least(period, MIN_PERIOD),
+            schedule: Periodic::new(period, MIN_PERIOD),
             overflow: counter_overflow,
             counter: 1,
-            running: false,
-            next: None,
             pending: false,
         })
     }
@@ -135,7 +131,7 @@ impl SyncProducer {
 
     /// The communication cycle period (`None`: no SYNC).
     pub const fn period(&self) -> Option<Duration> {
-        self.period
+        self.schedule.period()
     }
 
     /// The counter overflow value, `None` without a counter.
@@ -146,22 +142,20 @@ impl SyncProducer {
     /// Whether the producer has been started (and not stopped); it sends
     /// nothing without a period.
     pub const fn is_running(&self) -> bool {
-        self.running
+        self.schedule.is_running()
     }
 
     /// Starts producing: the counter restarts at 1, the first SYNC is due
     /// one period after `now`.
     pub fn start(&mut self, now: Instant) {
-        self.running = true;
+        self.schedule.start(now);
         self.counter = 1;
         self.pending = false;
-        self.next = self.period.map(|period| now + period);
     }
 
     /// Stops producing (a pending SYNC is discarded).
     pub fn stop(&mut self) {
-        self.running = false;
-        self.next = None;
+        self.schedule.stop();
         self.pending = false;
     }
 
@@ -169,10 +163,7 @@ impl SyncProducer {
     /// SYNC is due one new period after `now` (`None` pauses the producer,
     /// a later period resumes it).
     pub fn set_period(&mut self, now: Instant, period: Option<Duration>) {
-        self.period = at_least(period, MIN_PERIOD);
-        if self.is_running() {
-            self.next = self.period.map(|period| now + period);
-        }
+        self.schedule.set_period(now, period);
     }
 }
 
@@ -183,11 +174,8 @@ impl Service for SyncProducer {
     fn handle_frame(&mut self, _now: Instant, _frame: &Frame) {}
 
     fn handle_timeout(&mut self, now: Instant) {
-        if let Some(due) = self.next
-            && due <= now
-        {
+        if self.schedule.fire(now) {
             self.pending = true;
-            self.next = self.period.map(|period| next_period(due, now, period));
         }
     }
 
@@ -204,12 +192,8 @@ impl Service for SyncProducer {
         Some(sync_frame(self.cob_id, counter))
     }
 
-    fn poll_event(&mut self) -> Option<Self::Event> {
-        None
-    }
-
     fn poll_timeout(&self) -> Option<Instant> {
-        self.next
+        self.schedule.next()
     }
 }
 
@@ -242,11 +226,7 @@ pub struct SyncConsumer {
     events: Ring<SyncEvent, CONSUMER_EVENTS>,
 }
 
-impl Default for SyncConsumer {
-    fn default() -> Self {
-        SyncConsumer::new()
-    }
-}
+default_is_new!(SyncConsumer);
 
 impl SyncConsumer {
     /// A consumer on COB-ID 0x080.
@@ -296,18 +276,8 @@ impl Service for SyncConsumer {
         }
     }
 
-    fn handle_timeout(&mut self, _now: Instant) {}
-
-    fn poll_transmit(&mut self) -> Option<Frame> {
-        None
-    }
-
     fn poll_event(&mut self) -> Option<SyncEvent> {
         self.events.pop()
-    }
-
-    fn poll_timeout(&self) -> Option<Instant> {
-        None
     }
 }
 
@@ -315,22 +285,7 @@ impl Service for SyncConsumer {
 mod tests {
     use super::*;
     use crate::CanId;
-
-    fn data(id: u16, bytes: &[u8]) -> Frame {
-        Frame::new(CanId::Standard(id), bytes).unwrap()
-    }
-
-    fn ms(n: u64) -> Instant {
-        Instant::from_millis(n)
-    }
-
-    fn frames<S: Service>(s: &mut S) -> Vec<Frame> {
-        core::iter::from_fn(|| s.poll_transmit()).collect()
-    }
-
-    fn events<S: Service>(s: &mut S) -> Vec<S::Event> {
-        core::iter::from_fn(|| s.poll_event()).collect()
-    }
+    use crate::cores::testing::{assert_due, data, events, frames, ms};
 
     #[test]
     fn frames_without_counter() {
@@ -338,11 +293,7 @@ mod tests {
         assert_eq!(p.poll_timeout(), None);
         p.start(ms(100));
         assert!(frames(&mut p).is_empty());
-        assert_eq!(p.poll_timeout(), Some(ms(110)));
-        p.handle_timeout(ms(109));
-        assert!(frames(&mut p).is_empty());
-        p.handle_timeout(ms(110));
-        assert_eq!(frames(&mut p), [data(0x080, &[])]);
+        assert_due(&mut p, 110, &[data(0x080, &[])]);
         assert_eq!(frames(&mut p)[..], []);
         assert_eq!(p.poll_timeout(), Some(ms(120)));
     }

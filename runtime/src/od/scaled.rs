@@ -20,8 +20,10 @@ mod sealed {
     pub trait Sealed {}
 }
 
-macro_rules! scaled_ints {
-    ($($ty:ty),*) => {$(
+/// `ScaledRaw` for the primitive types `$ty`, with `from_steps` as given
+/// (the integers round and check their range, the floats take the steps).
+macro_rules! scaled_raw {
+    ($($ty:ty),* => |$steps:ident, $min:ident, $max:ident| $from_steps:expr) => {$(
         impl sealed::Sealed for $ty {}
         impl ScaledRaw for $ty {
             const MIN: Self = <$ty>::MIN;
@@ -31,38 +33,22 @@ macro_rules! scaled_ints {
                 self as f64
             }
             #[inline]
-            fn from_steps(steps: f64, min: Self, max: Self) -> Option<Self> {
-                let rounded = round_steps(steps, min as f64, max as f64)?;
-                if rounded < min as i128 || rounded > max as i128 {
-                    return None;
-                }
-                Some(rounded as $ty)
+            fn from_steps($steps: f64, $min: Self, $max: Self) -> Option<Self> {
+                $from_steps
             }
         }
     )*};
 }
 
-scaled_ints!(u8, u16, u32, u64, i8, i16, i32, i64);
+scaled_raw!(u8, u16, u32, u64, i8, i16, i32, i64 => |steps, min, max| {
+    let rounded = round_steps(steps, min as f64, max as f64)?;
+    if rounded < min as i128 || rounded > max as i128 {
+        return None;
+    }
+    Some(rounded as Self)
+});
 
-macro_rules! scaled_floats {
-    ($($ty:ty),*) => {$(
-        impl sealed::Sealed for $ty {}
-        impl ScaledRaw for $ty {
-            const MIN: Self = <$ty>::MIN;
-            const MAX: Self = <$ty>::MAX;
-            #[inline]
-            fn to_f64(self) -> f64 {
-                self as f64
-            }
-            #[inline]
-            fn from_steps(steps: f64, _min: Self, _max: Self) -> Option<Self> {
-                Some(steps as $ty)
-            }
-        }
-    )*};
-}
-
-scaled_floats!(f32, f64);
+scaled_raw!(f32, f64 => |steps, _min, _max| Some(steps as Self));
 
 /// `steps` rounded half away from zero, or `None` when it is NaN or more
 /// than one step outside `min..=max`.

@@ -77,14 +77,20 @@ fn a_slave_boots_step_by_step() {
     assert_eq!(boot.poll_request(), None);
 }
 
-#[test]
-fn a_wrong_product_code_is_status_m_with_both_values() {
+/// A boot that has seen the boot-up, the device type and the vendor id.
+fn identified() -> SlaveBoot {
     let mut boot = SlaveBoot::new(plan());
     boot.poll_request();
     boot.poll_request();
     boot.boot_up(NmtState::BootUp);
     read(&mut boot, 0x1000, 0, 0x0002_0192);
     read(&mut boot, 0x1018, 1, 0xAB);
+    boot
+}
+
+#[test]
+fn a_wrong_product_code_is_status_m_with_both_values() {
+    let mut boot = identified();
     assert_eq!(
         boot.poll_request(),
         Some(Request::Read {
@@ -117,12 +123,7 @@ fn no_boot_up_is_status_b() {
 
 #[test]
 fn an_abort_while_configuring_is_status_j_naming_the_entry() {
-    let mut boot = SlaveBoot::new(plan());
-    boot.poll_request();
-    boot.poll_request();
-    boot.boot_up(NmtState::BootUp);
-    read(&mut boot, 0x1000, 0, 0x0002_0192);
-    read(&mut boot, 0x1018, 1, 0xAB);
+    let mut boot = identified();
     read(&mut boot, 0x1018, 2, 0x1234);
     boot.poll_request();
     boot.write_done(Ok(())).unwrap();

@@ -243,51 +243,29 @@ mod tests {
         assert_eq!(run(None, KnownIdentity::NONE), (Progress::NotFound, 1));
     }
 
+    /// The request with these fields.
+    fn req(id_number: u32, bit_check: u8, sub: u8, next: u8) -> FastscanRequest {
+        FastscanRequest {
+            id_number,
+            bit_check,
+            sub,
+            next,
+        }
+    }
+
     #[test]
     fn request_fields() {
         let mut scan = Fastscan::new(KnownIdentity::NONE);
         assert_eq!(scan.request(), FastscanRequest::CONFIRM);
         scan.advance(true);
-        assert_eq!(
-            scan.request(),
-            FastscanRequest {
-                id_number: 0,
-                bit_check: 31,
-                sub: 0,
-                next: 0
-            }
-        );
+        assert_eq!(scan.request(), req(0, 31, 0, 0));
         scan.advance(false); // bit 31 is 1
-        assert_eq!(
-            scan.request(),
-            FastscanRequest {
-                id_number: 0x8000_0000,
-                bit_check: 30,
-                sub: 0,
-                next: 0
-            }
-        );
+        assert_eq!(scan.request(), req(0x8000_0000, 30, 0, 0));
         for _ in 0..31 {
             scan.advance(true);
         }
-        assert_eq!(
-            scan.request(),
-            FastscanRequest {
-                id_number: 0x8000_0000,
-                bit_check: 0,
-                sub: 0,
-                next: 1
-            }
-        );
+        assert_eq!(scan.request(), req(0x8000_0000, 0, 0, 1));
         scan.advance(true);
-        assert_eq!(
-            scan.request(),
-            FastscanRequest {
-                id_number: 0,
-                bit_check: 31,
-                sub: 1,
-                next: 1
-            }
-        );
+        assert_eq!(scan.request(), req(0, 31, 1, 1));
     }
 }

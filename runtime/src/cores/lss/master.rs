@@ -141,11 +141,7 @@ pub struct LssMaster {
     events: Ring<LssEvent, EVENTS>,
 }
 
-impl Default for LssMaster {
-    fn default() -> Self {
-        LssMaster::new()
-    }
-}
+default_is_new!(LssMaster);
 
 impl LssMaster {
     /// An idle master with [`DEFAULT_TIMEOUT`].

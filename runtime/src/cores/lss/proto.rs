@@ -51,35 +51,27 @@ pub mod cs {
 /// asks the non-configured ones to confirm their presence.
 pub const BIT_CHECK_CONFIRM: u8 = 0x80;
 
-/// One of the six frames of identify remote slave (0x46 to 0x4B).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
-#[repr(u8)]
-pub enum RangeField {
-    /// Vendor id (0x46).
-    VendorId = 0,
-    /// Product code (0x47).
-    ProductCode = 1,
-    /// Lowest revision number (0x48).
-    RevisionLow = 2,
-    /// Highest revision number (0x49).
-    RevisionHigh = 3,
-    /// Lowest serial number (0x4A).
-    SerialLow = 4,
-    /// Highest serial number (0x4B).
-    SerialHigh = 5,
+indexed_enum! {
+    /// One of the six frames of identify remote slave (0x46 to 0x4B).
+    pub enum RangeField {
+        /// Vendor id (0x46).
+        VendorId = 0,
+        /// Product code (0x47).
+        ProductCode = 1,
+        /// Lowest revision number (0x48).
+        RevisionLow = 2,
+        /// Highest revision number (0x49).
+        RevisionHigh = 3,
+        /// Lowest serial number (0x4A).
+        SerialLow = 4,
+        /// Highest serial number (0x4B).
+        SerialHigh = 5,
+    }
+    /// All fields, in the order the master sends them.
+    ALL;
 }
 
 impl RangeField {
-    /// All fields, in the order the master sends them.
-    pub const ALL: [RangeField; 6] = [
-        RangeField::VendorId,
-        RangeField::ProductCode,
-        RangeField::RevisionLow,
-        RangeField::RevisionHigh,
-        RangeField::SerialLow,
-        RangeField::SerialHigh,
-    ];
-
     /// The command specifier of this frame.
     pub const fn command(self) -> u8 {
         cs::IDENTIFY_REMOTE_VENDOR + self as u8
@@ -87,15 +79,7 @@ impl RangeField {
 
     /// The field whose command specifier is `cs`.
     pub const fn from_command(cs: u8) -> Option<RangeField> {
-        match cs.wrapping_sub(cs::IDENTIFY_REMOTE_VENDOR) {
-            0 => Some(RangeField::VendorId),
-            1 => Some(RangeField::ProductCode),
-            2 => Some(RangeField::RevisionLow),
-            3 => Some(RangeField::RevisionHigh),
-            4 => Some(RangeField::SerialLow),
-            5 => Some(RangeField::SerialHigh),
-            _ => None,
-        }
+        RangeField::from_index(cs.wrapping_sub(cs::IDENTIFY_REMOTE_VENDOR))
     }
 }
 

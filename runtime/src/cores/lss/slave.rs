@@ -364,9 +364,6 @@ impl Service for LssSlave {
         }
     }
 
-    /// The slave keeps no timers.
-    fn handle_timeout(&mut self, _now: Instant) {}
-
     fn poll_transmit(&mut self) -> Option<Frame> {
         self.outbox.pop()
     }
@@ -374,11 +371,8 @@ impl Service for LssSlave {
     fn poll_event(&mut self) -> Option<LssSlaveEvent> {
         self.events.pop()
     }
-
-    /// The slave keeps no timers.
-    fn poll_timeout(&self) -> Option<Instant> {
-        None
-    }
+    // The slave keeps no timers (the default `handle_timeout` and
+    // `poll_timeout`).
 }
 
 #[cfg(test)]

@@ -71,6 +71,31 @@ impl Loop {
         }
         panic!("the request did not end");
     }
+
+    /// Gives the configured slave node id `id`.
+    fn configure_node_id(&mut self, id: u8) {
+        let configured = self.run(|m, now| m.configure_node_id(now, node(id).unwrap()));
+        assert_eq!(configured, LssEvent::NodeIdConfigured);
+    }
+
+    /// Switches every slave back to waiting; returns what the slave reported
+    /// since it was created.
+    fn switch_to_waiting(&mut self) -> &[LssSlaveEvent] {
+        let sent = self.run(|m, now| m.switch_global(now, LssState::Waiting));
+        assert_eq!(sent, LssEvent::Sent);
+        &self.slave_events
+    }
+}
+
+/// What a slave reports when it is configured with node id `id`, then
+/// `between` happens, then it is switched back to waiting.
+fn configured(id: u8, between: LssSlaveEvent) -> [LssSlaveEvent; 4] {
+    [
+        LssSlaveEvent::StateChanged(LssState::Configuration),
+        LssSlaveEvent::NodeIdChanged { pending: node(id) },
+        between,
+        LssSlaveEvent::StateChanged(LssState::Waiting),
+    ]
 }
 
 const DRIVE: Identity = Identity::new(0x0000_04D8, 0x0000_1001, 0x0001_0002, 0x0012_D687);
@@ -118,23 +143,11 @@ fn configure_node_127_to_5_and_store() {
         bus.run(|m, now| m.switch_global(now, LssState::Configuration)),
         LssEvent::Sent
     );
-    assert_eq!(
-        bus.run(|m, now| m.configure_node_id(now, node(5).unwrap())),
-        LssEvent::NodeIdConfigured
-    );
+    bus.configure_node_id(5);
     assert_eq!(bus.run(LssMaster::store_configuration), LssEvent::Stored);
     assert_eq!(
-        bus.run(|m, now| m.switch_global(now, LssState::Waiting)),
-        LssEvent::Sent
-    );
-    assert_eq!(
-        bus.slave_events,
-        [
-            LssSlaveEvent::StateChanged(LssState::Configuration),
-            LssSlaveEvent::NodeIdChanged { pending: node(5) },
-            LssSlaveEvent::StoreRequested,
-            LssSlaveEvent::StateChanged(LssState::Waiting),
-        ]
+        bus.switch_to_waiting(),
+        configured(5, LssSlaveEvent::StoreRequested)
     );
     assert_eq!(
         (bus.slave.active_node_id(), bus.slave.pending_node_id()),
@@ -233,22 +246,10 @@ fn fastscan_then_configure() {
     assert_eq!(bus.frames, 133 + 5 + zeros as usize);
     // 133 steps of one timeout each.
     assert_eq!(bus.now, Instant::ZERO + DEFAULT_TIMEOUT * 133);
+    bus.configure_node_id(20);
     assert_eq!(
-        bus.run(|m, now| m.configure_node_id(now, node(20).unwrap())),
-        LssEvent::NodeIdConfigured
-    );
-    assert_eq!(
-        bus.run(|m, now| m.switch_global(now, LssState::Waiting)),
-        LssEvent::Sent
-    );
-    assert_eq!(
-        bus.slave_events,
-        [
-            LssSlaveEvent::StateChanged(LssState::Configuration),
-            LssSlaveEvent::NodeIdChanged { pending: node(20) },
-            LssSlaveEvent::ResetCommunication,
-            LssSlaveEvent::StateChanged(LssState::Waiting),
-        ]
+        bus.switch_to_waiting(),
+        configured(20, LssSlaveEvent::ResetCommunication)
     );
     // Now configured (pending), it no longer takes part.
     assert_eq!(

@@ -113,37 +113,15 @@ impl Service for NmtSlave {
         }
     }
 
-    fn handle_timeout(&mut self, _now: Instant) {}
-
-    fn poll_transmit(&mut self) -> Option<Frame> {
-        None
-    }
-
     fn poll_event(&mut self) -> Option<NmtSlaveEvent> {
         self.events.pop()
-    }
-
-    fn poll_timeout(&self) -> Option<Instant> {
-        None
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::CanId;
-
-    fn node(n: u8) -> NodeId {
-        NodeId::new(n).unwrap()
-    }
-
-    fn data(id: u16, bytes: &[u8]) -> Frame {
-        Frame::new(CanId::Standard(id), bytes).unwrap()
-    }
-
-    fn events<S: Service>(s: &mut S) -> Vec<S::Event> {
-        core::iter::from_fn(|| s.poll_event()).collect()
-    }
+    use crate::cores::testing::{data, events, node};
 
     #[test]
     fn slave_follows_commands() {

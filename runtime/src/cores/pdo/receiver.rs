@@ -346,10 +346,6 @@ impl<const N: usize> Service for PdoReceiver<N> {
         }
     }
 
-    fn poll_transmit(&mut self) -> Option<Frame> {
-        None
-    }
-
     fn poll_event(&mut self) -> Option<PdoEvent> {
         self.events.pop()
     }

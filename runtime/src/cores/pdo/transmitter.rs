@@ -386,10 +386,6 @@ impl Service for PdoTransmitter {
         self.outbox.take()
     }
 
-    fn poll_event(&mut self) -> Option<Self::Event> {
-        None
-    }
-
     fn poll_timeout(&self) -> Option<Instant> {
         if !self.is_enabled() || self.mode != Mode::Event {
             return None;

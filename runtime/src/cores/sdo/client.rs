@@ -3,8 +3,8 @@
 //!
 //! Expedited, segmented and block transfers in both directions; every frame
 //! is built and parsed by [`super::proto`]. The client sends on
-//! [`Channel::request`] and listens only to data frames on
-//! [`Channel::response`] (11- or 29-bit, as the channel says); it ignores
+//! [`Channel::request`](super::Channel::request) and listens only to data frames on
+//! [`Channel::response`](super::Channel::response) (11- or 29-bit, as the channel says); it ignores
 //! everything else, and every frame while idle.
 //!
 //! Each step waits [`ClientConfig::timeout`] for the server's next frame. A
@@ -31,6 +31,7 @@
 //! [`SdoError::RemoteAbort`] and nothing is sent.
 
 mod block;
+mod config;
 mod segmented;
 mod service;
 mod stream;
@@ -40,16 +41,16 @@ mod tests;
 use alloc::collections::VecDeque;
 use alloc::vec::Vec;
 use core::mem;
-use core::time::Duration;
 
 use super::proto::{Initiate, Request, Response};
-use super::{AbortCode, Channel, DEFAULT_TIMEOUT, MAX_BLOCK_SIZE, SdoError};
+use super::{AbortCode, MAX_BLOCK_SIZE, SdoError};
 use crate::Instant;
 #[cfg(doc)]
 use crate::Service;
 
 use crate::queue::Ring;
 use block::{DownloadBlock, UploadBlock};
+pub use config::{ClientConfig, Method};
 pub use stream::WINDOW;
 use stream::{Crc16, Outgoing};
 
@@ -61,67 +62,6 @@ const SEGMENT_BYTES: usize = 7;
 /// Events the client holds for [`Service::poll_event`]; starting a transfer
 /// while this many wait is refused with [`Busy`].
 pub const MAX_PENDING_EVENTS: usize = 8;
-
-/// How a transfer is carried out.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum Method {
-    /// Downloads: expedited up to 4 bytes, block above
-    /// [`ClientConfig::block_download_above`] (when set), segmented otherwise.
-    /// Uploads: block when [`ClientConfig::block_upload`], else standard.
-    #[default]
-    Auto,
-    /// The standard protocol: expedited when the data fits 4 bytes (the
-    /// server decides for uploads), segmented otherwise.
-    Standard,
-    /// Segmented even for 4 bytes or less (downloads; uploads as Standard).
-    Segmented,
-    /// Block transfer.
-    Block,
-}
-
-/// Client settings.
-#[derive(Debug, Clone, PartialEq, Eq)]
-#[non_exhaustive]
-pub struct ClientConfig {
-    /// The COB-IDs the client sends requests on and receives responses from.
-    pub channel: Channel,
-    /// Time the server has to answer each frame.
-    pub timeout: Duration,
-    /// Block size asked for in block uploads (1 to 127; other values are
-    /// clamped into that range).
-    pub block_size: u8,
-    /// Offer CRC in block transfers.
-    pub crc: bool,
-    /// Largest upload accepted; a server announcing more gets abort
-    /// 0x05040005 (out of memory) before anything is allocated.
-    pub max_upload: usize,
-    /// Use block download (with [`Method::Auto`]) above this many bytes.
-    pub block_download_above: Option<usize>,
-    /// Use block upload with [`Method::Auto`].
-    pub block_upload: bool,
-    /// Typed reads refuse a value longer than the entry's data type (a
-    /// device answering 4 bytes for an UNSIGNED8) with a length error,
-    /// instead of taking its leading bytes and leaving a
-    /// [`LengthNote`](super::typed::LengthNote).
-    pub strict_lengths: bool,
-}
-
-impl ClientConfig {
-    /// Defaults: 500 ms timeout, block size 127, CRC offered, uploads up to
-    /// 1 MiB, no block transfers with [`Method::Auto`].
-    pub fn new(channel: Channel) -> ClientConfig {
-        ClientConfig {
-            channel,
-            timeout: DEFAULT_TIMEOUT,
-            block_size: super::MAX_BLOCK_SIZE,
-            crc: true,
-            max_upload: 1 << 20,
-            block_download_above: None,
-            block_upload: false,
-            strict_lengths: false,
-        }
-    }
-}
 
 /// The client is already running a transfer (or holds
 /// [`MAX_PENDING_EVENTS`] events the caller has not polled).
@@ -318,23 +258,19 @@ impl SdoClient {
         method: Method,
     ) -> Result<(), Busy> {
         self.start(index, sub)?;
-        let block = match method {
-            Method::Auto => self.config.block_upload,
-            Method::Block => true,
-            Method::Standard | Method::Segmented => false,
-        };
-        if block {
-            self.send(Request::BlockUploadInitiate {
+        if method.is_block(self.config.block_upload) {
+            let (crc, block_size) = (self.config.crc, self.block_size());
+            let request = Request::BlockUploadInitiate {
                 index,
                 sub,
-                crc: self.config.crc,
-                block_size: self.block_size(),
+                crc,
+                block_size,
                 pst: 0,
-            });
-            self.wait(now, Phase::BlockUploadInitiate);
+            };
+            self.request(now, request, Phase::BlockUploadInitiate);
         } else {
-            self.send(Request::UploadInitiate { index, sub });
-            self.wait(now, Phase::UploadInitiate);
+            let request = Request::UploadInitiate { index, sub };
+            self.request(now, request, Phase::UploadInitiate);
         }
         Ok(())
     }
@@ -367,15 +303,10 @@ impl SdoClient {
             for (slot, byte) in bytes.iter_mut().zip(data) {
                 *slot = *byte;
             }
-            self.send(Request::DownloadInitiate {
-                index,
-                sub,
-                data: Initiate::Expedited {
-                    data: bytes,
-                    len: Some(size as u8),
-                },
-            });
-            self.wait(now, Phase::ExpeditedDownload { len: size as u8 });
+            let len = Some(size as u8);
+            let data = Initiate::Expedited { data: bytes, len };
+            let request = Request::DownloadInitiate { index, sub, data };
+            self.request(now, request, Phase::ExpeditedDownload { len: size as u8 });
             return Ok(());
         }
         self.out.reset(false, Some(data.len()));
@@ -385,7 +316,7 @@ impl SdoClient {
         }
         self.out.push(data);
         self.out.ended = true;
-        self.initiate_download(now, index, sub, Some(size), method);
+        self.initiate_download(now, Some(size), method);
         Ok(())
     }
 
@@ -422,6 +353,12 @@ impl SdoClient {
         self.tx.push(request.encode());
     }
 
+    /// Sends `request` and waits for the answer in `phase`.
+    fn request(&mut self, now: Instant, request: Request, phase: Phase) {
+        self.send(request);
+        self.wait(now, phase);
+    }
+
     /// Enters `phase`, waiting for the server until `now` plus the timeout.
     fn wait(&mut self, now: Instant, phase: Phase) {
         self.phase = phase;
@@ -430,6 +367,16 @@ impl SdoClient {
 
     fn is_ours(&self, index: u16, sub: u8) -> bool {
         index == self.index && sub == self.sub
+    }
+
+    /// An answer about (index, sub): `Ok` when that is the object of the
+    /// transfer, else the transfer ends (ParameterIncompatible).
+    fn check_ours(&mut self, index: u16, sub: u8) -> Result<(), Ended> {
+        if self.is_ours(index, sub) {
+            Ok(())
+        } else {
+            Err(self.fail(AbortCode::ParameterIncompatible))
+        }
     }
 
     /// Ends the transfer: sends abort `code` and reports `LocalAbort(code)`.

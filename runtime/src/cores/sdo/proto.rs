@@ -11,6 +11,10 @@ use core::fmt;
 
 use super::AbortCode;
 
+mod layout;
+
+use layout::*;
+
 /// Data of an initiate request or response.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Initiate {
@@ -171,94 +175,20 @@ impl fmt::Display for ParseError {
     }
 }
 
-fn eight(data: &[u8]) -> Result<&[u8; 8], ParseError> {
-    data.try_into().map_err(|_| ParseError::Length(data.len()))
-}
-
-fn address(d: &[u8; 8]) -> (u16, u8) {
-    (u16::from_le_bytes([d[1], d[2]]), d[3])
-}
-
-fn put_address(d: &mut [u8; 8], index: u16, sub: u8) {
-    d[1..3].copy_from_slice(&index.to_le_bytes());
-    d[3] = sub;
-}
-
-fn u32_at(d: &[u8; 8]) -> u32 {
-    u32::from_le_bytes([d[4], d[5], d[6], d[7]])
-}
-
-fn bit(b: u8, n: u8) -> bool {
-    b >> n & 1 != 0
-}
-
-/// Initiate (download request or upload response): `e` bit 1, `s` bit 0,
-/// `n` bits 3-2.
-fn parse_initiate(d: &[u8; 8]) -> Initiate {
-    let b = d[0];
-    let (expedited, sized) = (bit(b, 1), bit(b, 0));
-    if expedited {
-        let len = sized.then(|| 4 - (b >> 2 & 3));
-        Initiate::Expedited {
-            data: [d[4], d[5], d[6], d[7]],
-            len,
-        }
-    } else {
-        Initiate::Segmented {
-            size: sized.then(|| u32_at(d)),
-        }
-    }
-}
-
-fn put_initiate(d: &mut [u8; 8], data: &Initiate) {
-    match *data {
-        Initiate::Expedited { data, len: None } => {
-            d[0] |= 0b10;
-            d[4..8].copy_from_slice(&data);
-        }
-        Initiate::Expedited {
-            data,
-            len: Some(len),
-        } => {
-            let len = len.clamp(1, 4);
-            d[0] |= (4 - len) << 2 | 0b11;
-            d[4..8].copy_from_slice(&data);
-            // Bytes beyond the length are zero on the bus.
-            for b in &mut d[4 + len as usize..8] {
-                *b = 0;
-            }
-        }
-        Initiate::Segmented { size } => {
-            if let Some(size) = size {
-                d[0] |= 1;
-                d[4..8].copy_from_slice(&size.to_le_bytes());
-            }
-        }
-    }
-}
-
-/// Segment (download request or upload response): `t` bit 4, `n` bits 3-1,
-/// `c` bit 0.
-fn parse_segment(d: &[u8; 8]) -> (bool, bool, [u8; 7], u8) {
-    let b = d[0];
-    let mut data = [0u8; 7];
-    data.copy_from_slice(&d[1..8]);
-    (bit(b, 4), bit(b, 0), data, 7 - (b >> 1 & 7))
-}
-
-fn put_segment(d: &mut [u8; 8], toggle: bool, last: bool, data: &[u8; 7], len: u8) {
-    let len = len.min(7);
-    d[0] |= (toggle as u8) << 4 | (7 - len) << 1 | last as u8;
-    d[1..1 + len as usize].copy_from_slice(&data[..len as usize]);
-}
-
-fn put_abort(d: &mut [u8; 8], index: u16, sub: u8, code: AbortCode) {
-    d[0] = 0x80;
-    put_address(d, index, sub);
-    d[4..8].copy_from_slice(&code.code().to_le_bytes());
-}
-
 impl Request {
+    /// The object whose transfer an initiate request starts; `None` for
+    /// other requests.
+    #[cfg(feature = "alloc")]
+    pub(crate) fn initiated_object(&self) -> Option<(u16, u8)> {
+        match *self {
+            Request::DownloadInitiate { index, sub, .. }
+            | Request::UploadInitiate { index, sub }
+            | Request::BlockDownloadInitiate { index, sub, .. }
+            | Request::BlockUploadInitiate { index, sub, .. } => Some((index, sub)),
+            _ => None,
+        }
+    }
+
     pub fn parse(data: &[u8]) -> Result<Request, ParseError> {
         let d = eight(data)?;
         let b = d[0];
@@ -300,20 +230,19 @@ impl Request {
                 },
                 _ => Request::BlockUploadStart,
             },
-            6 => {
-                if b & 1 == 0 {
-                    Request::BlockDownloadInitiate {
-                        index,
-                        sub,
-                        crc: bit(b, 2),
-                        size: bit(b, 1).then(|| u32_at(d)),
-                    }
-                } else {
-                    Request::BlockDownloadEnd {
-                        unused: b >> 2 & 7,
-                        crc: u16::from_le_bytes([d[1], d[2]]),
-                    }
+            6 if b & 1 == 0 => {
+                let crc = bit(b, 2);
+                let size = block_size_field(d);
+                Request::BlockDownloadInitiate {
+                    index,
+                    sub,
+                    crc,
+                    size,
                 }
+            }
+            6 => {
+                let (unused, crc) = block_end(d);
+                Request::BlockDownloadEnd { unused, crc }
             }
             _ => return Err(ParseError::Command(b)),
         })
@@ -350,14 +279,9 @@ impl Request {
                 crc,
                 size,
             } => {
-                d[0] = 0xC0 | (crc as u8) << 2 | (size.is_some() as u8) << 1;
-                put_address(&mut d, index, sub);
-                d[4..8].copy_from_slice(&size.unwrap_or(0).to_le_bytes());
+                put_block_send(&mut d, index, sub, crc, size);
             }
-            Request::BlockDownloadEnd { unused, crc } => {
-                d[0] = 0xC1 | (unused & 7) << 2;
-                d[1..3].copy_from_slice(&crc.to_le_bytes());
-            }
+            Request::BlockDownloadEnd { unused, crc } => put_block_end(&mut d, unused, crc),
             Request::BlockUploadInitiate {
                 index,
                 sub,
@@ -365,20 +289,14 @@ impl Request {
                 block_size,
                 pst,
             } => {
-                d[0] = 0xA0 | (crc as u8) << 2;
-                put_address(&mut d, index, sub);
-                d[4] = block_size;
+                put_block_receive(&mut d, index, sub, crc, block_size);
                 d[5] = pst;
             }
             Request::BlockUploadStart => d[0] = 0xA3,
             Request::BlockUploadAck {
                 ack_seq,
                 block_size,
-            } => {
-                d[0] = 0xA2;
-                d[1] = ack_seq;
-                d[2] = block_size;
-            }
+            } => put_block_ack(&mut d, ack_seq, block_size),
             Request::BlockUploadEnd => d[0] = 0xA1,
             Request::Abort { index, sub, code } => put_abort(&mut d, index, sub, code),
         }
@@ -477,20 +395,19 @@ impl Response {
                 },
                 _ => return Err(ParseError::Command(b)),
             },
-            6 => {
-                if b & 1 == 0 {
-                    Response::BlockUploadInitiate {
-                        index,
-                        sub,
-                        crc: bit(b, 2),
-                        size: bit(b, 1).then(|| u32_at(d)),
-                    }
-                } else {
-                    Response::BlockUploadEnd {
-                        unused: b >> 2 & 7,
-                        crc: u16::from_le_bytes([d[1], d[2]]),
-                    }
+            6 if b & 1 == 0 => {
+                let crc = bit(b, 2);
+                let size = block_size_field(d);
+                Response::BlockUploadInitiate {
+                    index,
+                    sub,
+                    crc,
+                    size,
                 }
+            }
+            6 => {
+                let (unused, crc) = block_end(d);
+                Response::BlockUploadEnd { unused, crc }
             }
             _ => return Err(ParseError::Command(b)),
         })
@@ -526,19 +443,11 @@ impl Response {
                 sub,
                 crc,
                 block_size,
-            } => {
-                d[0] = 0xA0 | (crc as u8) << 2;
-                put_address(&mut d, index, sub);
-                d[4] = block_size;
-            }
+            } => put_block_receive(&mut d, index, sub, crc, block_size),
             Response::BlockDownloadAck {
                 ack_seq,
                 block_size,
-            } => {
-                d[0] = 0xA2;
-                d[1] = ack_seq;
-                d[2] = block_size;
-            }
+            } => put_block_ack(&mut d, ack_seq, block_size),
             Response::BlockDownloadEnd => d[0] = 0xA1,
             Response::BlockUploadInitiate {
                 index,
@@ -546,14 +455,9 @@ impl Response {
                 crc,
                 size,
             } => {
-                d[0] = 0xC0 | (crc as u8) << 2 | (size.is_some() as u8) << 1;
-                put_address(&mut d, index, sub);
-                d[4..8].copy_from_slice(&size.unwrap_or(0).to_le_bytes());
+                put_block_send(&mut d, index, sub, crc, size);
             }
-            Response::BlockUploadEnd { unused, crc } => {
-                d[0] = 0xC1 | (unused & 7) << 2;
-                d[1..3].copy_from_slice(&crc.to_le_bytes());
-            }
+            Response::BlockUploadEnd { unused, crc } => put_block_end(&mut d, unused, crc),
             Response::Abort { index, sub, code } => put_abort(&mut d, index, sub, code),
         }
         d

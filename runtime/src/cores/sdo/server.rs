@@ -325,6 +325,41 @@ impl<S: ObjectStore> SdoServer<S> {
         self.finish();
     }
 
+    /// The size a download initiate announced, checked: within
+    /// `max_download` (else OutOfMemory) and accepted by the store for the
+    /// object (else the store's abort code).
+    fn download_size(&mut self, size: Option<u32>) -> Result<Option<usize>, AbortCode> {
+        let size = match size.map(usize::try_from) {
+            None => None,
+            Some(Ok(size)) if size <= self.config.max_download => Some(size),
+            Some(_) => return Err(AbortCode::OutOfMemory),
+        };
+        let (index, sub) = self.object;
+        self.store.check_write(index, sub, size)?;
+        Ok(size)
+    }
+
+    /// Ends a download whose value is in the buffer: checks its length
+    /// against the announced `size`, writes it to the store, answers with
+    /// `reply` and reports it; a wrong length or a refused write aborts
+    /// instead.
+    fn complete_download(&mut self, size: Option<usize>, reply: Response) {
+        let len = self.buf.len();
+        if let Some(size) = size
+            && len != size
+        {
+            return self.fail(length_error(len, size));
+        }
+        let (index, sub) = self.object;
+        match self.store.write(index, sub, &self.buf) {
+            Ok(()) => {
+                self.send(reply);
+                self.succeed(ServerEvent::Downloaded { index, sub, len });
+            }
+            Err(code) => self.fail(code),
+        }
+    }
+
     /// A request that does not fit the current state: aborts the running
     /// transfer, or answers with an abort when there is none.
     fn reject(&mut self, code: AbortCode) {
@@ -363,35 +398,19 @@ impl<S: ObjectStore> SdoServer<S> {
 
     /// Dispatches one parsed request.
     fn handle_request(&mut self, request: Request) {
+        if let Some((index, sub)) = request.initiated_object() {
+            self.begin(index, sub);
+        }
         match request {
             Request::Abort { code, .. } => self.remote_abort(code),
-            Request::DownloadInitiate { index, sub, data } => {
-                self.begin(index, sub);
-                self.download_initiate(data);
-            }
-            Request::UploadInitiate { index, sub } => {
-                self.begin(index, sub);
-                self.upload_initiate();
-            }
-            Request::BlockDownloadInitiate {
-                index,
-                sub,
-                crc,
-                size,
-            } => {
-                self.begin(index, sub);
+            Request::DownloadInitiate { data, .. } => self.download_initiate(data),
+            Request::UploadInitiate { .. } => self.upload_initiate(),
+            Request::BlockDownloadInitiate { crc, size, .. } => {
                 self.block_download_initiate(crc, size);
             }
             Request::BlockUploadInitiate {
-                index,
-                sub,
-                crc,
-                block_size,
-                pst: _,
-            } => {
-                self.begin(index, sub);
-                self.block_upload_initiate(crc, block_size);
-            }
+                crc, block_size, ..
+            } => self.block_upload_initiate(crc, block_size),
             Request::DownloadSegment {
                 toggle,
                 last,

@@ -4,8 +4,8 @@ use core::fmt;
 use core::time::Duration;
 
 use super::{DEFAULT_COB_ID, TimeError, TimeOfDay};
-use crate::heartbeat::{at_least, next_period};
 use crate::queue::Ring;
+use crate::time::Periodic;
 use crate::{CanId, Frame, Instant, Service};
 
 /// The shortest TIME period: 1 ms, the resolution of TIME_OF_DAY.
@@ -139,9 +139,7 @@ pub fn time_frame(id: CanId, time: TimeOfDay) -> Frame {
 #[derive(Debug, Clone)]
 pub struct TimeProducer {
     id: CanId,
-    period: Option<Duration>,
-    running: bool,
-    next: Option<Instant>,
+    schedule: Periodic,
     reference: Option<(Instant, TimeOfDay)>,
     pending: Option<Frame>,
     skipped: u32,
@@ -151,9 +149,7 @@ impl Default for TimeProducer {
     fn default() -> Self {
         TimeProducer {
             id: CanId::Standard(DEFAULT_COB_ID),
-            period: None,
-            running: false,
-            next: None,
+            schedule: Periodic::new(None, MIN_PERIOD),
             reference: None,
             pending: None,
             skipped: 0,
@@ -167,7 +163,7 @@ impl TimeProducer {
     /// below 1 ms, the resolution of TIME, counts as 1 ms).
     pub fn new(period: Option<Duration>) -> TimeProducer {
         TimeProducer {
-            period: at_least(period, MIN_PERIOD),
+            schedule: Periodic::new(period, MIN_PERIOD),
             ..TimeProducer::default()
         }
     }
@@ -176,7 +172,7 @@ impl TimeProducer {
     pub fn with_id(id: CanId, period: Option<Duration>) -> Result<TimeProducer, TimeConfigError> {
         Ok(TimeProducer {
             id: checked_id(id)?,
-            period: at_least(period, MIN_PERIOD),
+            schedule: Periodic::new(period, MIN_PERIOD),
             ..TimeProducer::default()
         })
     }
@@ -188,12 +184,12 @@ impl TimeProducer {
 
     /// The period of the periodic TIME (`None`: none).
     pub const fn period(&self) -> Option<Duration> {
-        self.period
+        self.schedule.period()
     }
 
     /// Whether the producer has been started (and not stopped).
     pub const fn is_running(&self) -> bool {
-        self.running
+        self.schedule.is_running()
     }
 
     /// Periodic TIME frames skipped: no reference time, or out of range.
@@ -236,24 +232,19 @@ impl TimeProducer {
 
     /// Starts the periodic TIME: the first one is due at `now`.
     pub fn start(&mut self, now: Instant) {
-        self.running = true;
-        self.next = self.period.map(|_| now);
+        self.schedule.start_at_once(now);
     }
 
     /// Stops the periodic TIME (a frame not yet polled is discarded).
     pub fn stop(&mut self) {
-        self.running = false;
-        self.next = None;
+        self.schedule.stop();
         self.pending = None;
     }
 
     /// Changes the period; when running, the next TIME is due one new
     /// period after `now` (`None` pauses the periodic TIME).
     pub fn set_period(&mut self, now: Instant, period: Option<Duration>) {
-        self.period = at_least(period, MIN_PERIOD);
-        if self.running {
-            self.next = self.period.map(|period| now + period);
-        }
+        self.schedule.set_period(now, period);
     }
 }
 
@@ -270,12 +261,7 @@ impl Service for TimeProducer {
     fn handle_frame(&mut self, _now: Instant, _frame: &Frame) {}
 
     fn handle_timeout(&mut self, now: Instant) {
-        let Some(due) = self.next else { return };
-        if due > now {
-            return;
-        }
-        self.next = self.period.map(|period| next_period(due, now, period));
-        if self.send_now(now).is_none() {
+        if self.schedule.fire(now) && self.send_now(now).is_none() {
             self.skipped = self.skipped.saturating_add(1);
         }
     }
@@ -284,12 +270,8 @@ impl Service for TimeProducer {
         self.pending.take()
     }
 
-    fn poll_event(&mut self) -> Option<Self::Event> {
-        None
-    }
-
     fn poll_timeout(&self) -> Option<Instant> {
-        self.next
+        self.schedule.next()
     }
 }
 
@@ -337,11 +319,7 @@ pub struct TimeConsumer {
     events: Ring<TimeEvent, CONSUMER_EVENTS>,
 }
 
-impl Default for TimeConsumer {
-    fn default() -> Self {
-        TimeConsumer::new()
-    }
-}
+default_is_new!(TimeConsumer);
 
 impl TimeConsumer {
     /// A consumer on the 11-bit identifier 0x100.
@@ -411,17 +389,7 @@ impl Service for TimeConsumer {
         self.events.push(event);
     }
 
-    fn handle_timeout(&mut self, _now: Instant) {}
-
-    fn poll_transmit(&mut self) -> Option<Frame> {
-        None
-    }
-
     fn poll_event(&mut self) -> Option<TimeEvent> {
         self.events.pop()
-    }
-
-    fn poll_timeout(&self) -> Option<Instant> {
-        None
     }
 }

@@ -3,10 +3,10 @@
 //! bytes 4..=5 the days since 1984-01-01 (little endian).
 
 use std::string::ToString;
-use std::vec::Vec;
 
 use super::*;
-use crate::{CanId, Frame, Instant, Service};
+use crate::cores::testing::{events, frames, ms};
+use crate::{CanId, Frame, Service};
 
 fn civil(y: u16, mo: u8, d: u8, h: u8, mi: u8, s: u8, ms: u16) -> TimeOfDay {
     TimeOfDay::from_civil(DateTime::new(y, mo, d, h, mi, s, ms)).unwrap()
@@ -329,18 +329,6 @@ fn cob_id_object() {
             .to_string()
             .contains("0x00000800")
     );
-}
-
-fn ms(n: u64) -> Instant {
-    Instant::from_millis(n)
-}
-
-fn frames<S: Service>(s: &mut S) -> Vec<Frame> {
-    core::iter::from_fn(|| s.poll_transmit()).collect()
-}
-
-fn events<S: Service>(s: &mut S) -> Vec<S::Event> {
-    core::iter::from_fn(|| s.poll_event()).collect()
 }
 
 #[test]

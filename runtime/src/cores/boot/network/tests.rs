@@ -123,9 +123,10 @@ fn identify_and_configure(boot: &mut NetworkBoot, at: Instant) {
     assert!(boot.sdo_event(at, id(5), &done));
 }
 
-#[test]
-fn the_wait_for_the_first_heartbeat_ends_with_the_boot_time() {
-    let mut config = slave(5, true);
+/// A started boot of node 5 (`mandatory` or not), heartbeat-supervised
+/// (150 ms), with a boot time of 1 s.
+fn heartbeat_boot(mandatory: bool) -> NetworkBoot {
+    let mut config = slave(5, mandatory);
     config.plan.heartbeat = true;
     config.supervision = Supervision::Heartbeat(Duration::from_millis(150));
     let mut p = plan(vec![config]);
@@ -133,6 +134,12 @@ fn the_wait_for_the_first_heartbeat_ends_with_the_boot_time() {
     let mut boot = NetworkBoot::new(p);
     boot.start(Instant::ZERO);
     actions(&mut boot);
+    boot
+}
+
+#[test]
+fn the_wait_for_the_first_heartbeat_ends_with_the_boot_time() {
+    let mut boot = heartbeat_boot(true);
     // The boot-up comes late, just within the boot time.
     identify_and_configure(&mut boot, Instant::from_millis(990));
     assert_eq!(
@@ -160,14 +167,7 @@ fn the_wait_for_the_first_heartbeat_ends_with_the_boot_time() {
 
 #[test]
 fn after_the_first_boot_the_heartbeat_wait_is_the_response_time() {
-    let mut config = slave(5, false);
-    config.plan.heartbeat = true;
-    config.supervision = Supervision::Heartbeat(Duration::from_millis(150));
-    let mut p = plan(vec![config]);
-    p.boot_time = Some(Duration::from_millis(1000));
-    let mut boot = NetworkBoot::new(p);
-    boot.start(Instant::ZERO);
-    actions(&mut boot);
+    let mut boot = heartbeat_boot(false);
     // No boot-up within the boot time: the optional slave fails (B).
     boot.handle_timeout(Instant::from_millis(1000));
     assert_eq!(boot.outcome(), Some(true));

@@ -4,10 +4,7 @@
 use core::time::Duration;
 
 use super::*;
-
-fn ms(n: u64) -> Instant {
-    Instant::from_millis(n)
-}
+use crate::cores::testing::ms;
 
 /// Every pending write as (index, sub-index, little-endian bytes).
 fn writes(d: &mut Drive) -> Vec<(u16, u8, Vec<u8>)> {

@@ -3,11 +3,8 @@
 
 use super::*;
 use crate::CanId;
+use crate::cores::testing::ms;
 use crate::od::NodeId;
-
-fn ms(n: u64) -> Instant {
-    Instant::from_millis(n)
-}
 
 fn sent(master: &mut LssMaster) -> Vec<[u8; 8]> {
     core::iter::from_fn(|| master.poll_transmit())

@@ -166,31 +166,23 @@ fn configure_node_id_is_pending_until_applied() {
 
 #[test]
 fn switching_to_waiting_with_a_first_node_id_resets_communication() {
-    let mut s = slave(None);
-    send(&mut s, GLOBAL_CONFIG);
-    send(&mut s, [0x11, 9, 0, 0, 0, 0, 0, 0]);
-    events(&mut s);
-    send(&mut s, GLOBAL_WAITING);
-    assert_eq!(
-        events(&mut s),
-        [
-            LssSlaveEvent::ResetCommunication,
-            LssSlaveEvent::StateChanged(LssState::Waiting)
-        ]
-    );
     // A node that already had an id only changes state.
-    let mut s = slave(node(3));
-    send(&mut s, GLOBAL_CONFIG);
-    send(&mut s, [0x11, 9, 0, 0, 0, 0, 0, 0]);
-    events(&mut s);
-    send(&mut s, GLOBAL_WAITING);
-    assert_eq!(
-        events(&mut s),
-        [LssSlaveEvent::StateChanged(LssState::Waiting)]
-    );
-    // Mode 2 is reserved: ignored.
-    send(&mut s, [0x04, 2, 0, 0, 0, 0, 0, 0]);
-    assert_eq!(s.state(), LssState::Waiting);
+    for (id, resets) in [(None, true), (node(3), false)] {
+        let mut s = slave(id);
+        send(&mut s, GLOBAL_CONFIG);
+        send(&mut s, [0x11, 9, 0, 0, 0, 0, 0, 0]);
+        events(&mut s);
+        send(&mut s, GLOBAL_WAITING);
+        let mut expected = Vec::new();
+        if resets {
+            expected.push(LssSlaveEvent::ResetCommunication);
+        }
+        expected.push(LssSlaveEvent::StateChanged(LssState::Waiting));
+        assert_eq!(events(&mut s), expected);
+        // Mode 2 is reserved: ignored.
+        send(&mut s, [0x04, 2, 0, 0, 0, 0, 0, 0]);
+        assert_eq!(s.state(), LssState::Waiting);
+    }
 }
 
 #[test]
@@ -253,22 +245,18 @@ fn store_configuration() {
 fn inquire_identity_answers_each_part() {
     let mut s = slave(node(1));
     send(&mut s, GLOBAL_CONFIG);
-    assert_eq!(
-        send(&mut s, [0x5A, 0, 0, 0, 0, 0, 0, 0]),
-        [[0x5A, 0x7A, 0x01, 0, 0, 0, 0, 0]]
-    );
-    assert_eq!(
-        send(&mut s, [0x5B, 0, 0, 0, 0, 0, 0, 0]),
-        [[0x5B, 0x01, 0x20, 0, 0, 0, 0, 0]]
-    );
-    assert_eq!(
-        send(&mut s, [0x5C, 0, 0, 0, 0, 0, 0, 0]),
-        [[0x5C, 0x01, 0, 0x03, 0, 0, 0, 0]]
-    );
-    assert_eq!(
-        send(&mut s, [0x5D, 0, 0, 0, 0, 0, 0, 0]),
-        [[0x5D, 0x34, 0x12, 0, 0, 0, 0, 0]]
-    );
+    for (cs, answer) in [
+        (0x5A, [0x7A, 0x01, 0, 0]),
+        (0x5B, [0x01, 0x20, 0, 0]),
+        (0x5C, [0x01, 0, 0x03, 0]),
+        (0x5D, [0x34, 0x12, 0, 0]),
+    ] {
+        let [a, b, c, d] = answer;
+        assert_eq!(
+            send(&mut s, [cs, 0, 0, 0, 0, 0, 0, 0]),
+            [[cs, a, b, c, d, 0, 0, 0]]
+        );
+    }
 }
 
 /// The six identify remote slave frames (0x46..=0x4B) for a range.

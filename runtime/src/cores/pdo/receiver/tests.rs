@@ -1,10 +1,8 @@
 use super::*;
 use crate::CanId;
+use crate::cores::pdo::test_pdos::Status;
+use crate::cores::testing::{data, ms};
 use crate::od::{NodeId, PdoDirection};
-
-fn data(id: u16, bytes: &[u8]) -> Frame {
-    Frame::new(CanId::Standard(id), bytes).unwrap()
-}
 
 fn cob(raw: u32) -> PdoCobId {
     PdoCobId(raw)
@@ -12,10 +10,6 @@ fn cob(raw: u32) -> PdoCobId {
 
 fn sid(id: u16) -> CanId {
     CanId::Standard(id)
-}
-
-fn ms(n: u64) -> Instant {
-    Instant::from_millis(n)
 }
 
 fn events<const N: usize>(r: &mut PdoReceiver<N>) -> Vec<PdoEvent> {
@@ -204,42 +198,6 @@ fn full_event_queue_drops_the_oldest() {
     );
 }
 
-/// A hand-written TPDO: status word (u16) and actual position (i32).
-#[derive(Debug, PartialEq)]
-struct Status {
-    status: u16,
-    position: i32,
-}
-
-impl od::Pdo for Status {
-    const DIRECTION: PdoDirection = PdoDirection::Tpdo;
-    const NUMBER: u16 = 1;
-    const COMMUNICATION_INDEX: u16 = 0x1800;
-    const MAPPING_INDEX: u16 = 0x1A00;
-    const LEN: usize = 6;
-    const MAPPING: &'static [u32] = &[0x6041_0010, 0x6064_0020];
-    fn default_cob_id(node: NodeId) -> Option<PdoCobId> {
-        Some(PdoCobId(0x4000_0180 + u32::from(node.get())))
-    }
-    fn decode(data: &[u8]) -> Result<Self, PdoLengthError> {
-        match *data {
-            [a, b, c, d, e, f] => Ok(Status {
-                status: u16::from_le_bytes([a, b]),
-                position: i32::from_le_bytes([c, d, e, f]),
-            }),
-            _ => Err(PdoLengthError {
-                expected: 6,
-                actual: data.len(),
-            }),
-        }
-    }
-    fn encode_into(&self, out: &mut [u8; 8]) -> usize {
-        out[..2].copy_from_slice(&self.status.to_le_bytes());
-        out[2..6].copy_from_slice(&self.position.to_le_bytes());
-        6
-    }
-}
-
 /// A PDO without a default COB-ID.
 struct NoDefault;
 
@@ -273,8 +231,8 @@ fn typed_access_decodes_the_generated_struct() {
     assert_eq!(
         r.latest::<Status>(sid(0x183)),
         Some(Ok(Status {
-            status: 0x0237,
-            position: -1000
+            word: 0x0237,
+            long: -1000
         }))
     );
     // A struct of another length gives the length error.

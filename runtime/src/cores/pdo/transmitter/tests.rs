@@ -1,17 +1,11 @@
 use super::*;
 use crate::CanId;
-use crate::od::{NodeId, PdoDirection, PdoLengthError};
-
-fn data(id: u16, bytes: &[u8]) -> Frame {
-    Frame::new(CanId::Standard(id), bytes).unwrap()
-}
+use crate::cores::pdo::test_pdos::Command;
+use crate::cores::testing::{assert_due, data, ms};
+use crate::od::NodeId;
 
 fn us(n: u64) -> Instant {
     Instant::from_micros(n)
-}
-
-fn ms(n: u64) -> Instant {
-    Instant::from_millis(n)
 }
 
 fn sync() -> Frame {
@@ -205,11 +199,7 @@ fn event_timer_resends_without_events() {
     assert_eq!(t.poll_timeout(), None, "no data yet");
     t.set_data(ms(0), &[7]).unwrap();
     assert_eq!(frames(&mut t), [data(0x201, &[7])]);
-    assert_eq!(t.poll_timeout(), Some(ms(100)));
-    t.handle_timeout(ms(99));
-    assert!(frames(&mut t).is_empty());
-    t.handle_timeout(ms(100));
-    assert_eq!(frames(&mut t), [data(0x201, &[7])]);
+    assert_due(&mut t, 100, &[data(0x201, &[7])]);
     assert_eq!(t.poll_timeout(), Some(ms(200)));
     t.handle_timeout(ms(200));
     assert_eq!(frames(&mut t), [data(0x201, &[7])]);
@@ -328,42 +318,6 @@ fn invalid_configurations_are_refused() {
     assert!(frames(&mut t).is_empty());
 }
 
-/// A hand-written RPDO: a u16 control word and an i32 target.
-#[derive(Debug, PartialEq)]
-struct Command {
-    control: u16,
-    target: i32,
-}
-
-impl od::Pdo for Command {
-    const DIRECTION: PdoDirection = PdoDirection::Rpdo;
-    const NUMBER: u16 = 1;
-    const COMMUNICATION_INDEX: u16 = 0x1400;
-    const MAPPING_INDEX: u16 = 0x1600;
-    const LEN: usize = 6;
-    const MAPPING: &'static [u32] = &[0x6040_0010, 0x607A_0020];
-    fn default_cob_id(node: NodeId) -> Option<PdoCobId> {
-        Some(PdoCobId(0x200 + u32::from(node.get())))
-    }
-    fn decode(data: &[u8]) -> Result<Self, PdoLengthError> {
-        match *data {
-            [a, b, c, d, e, f] => Ok(Command {
-                control: u16::from_le_bytes([a, b]),
-                target: i32::from_le_bytes([c, d, e, f]),
-            }),
-            _ => Err(PdoLengthError {
-                expected: 6,
-                actual: data.len(),
-            }),
-        }
-    }
-    fn encode_into(&self, out: &mut [u8; 8]) -> usize {
-        out[..2].copy_from_slice(&self.control.to_le_bytes());
-        out[2..6].copy_from_slice(&self.target.to_le_bytes());
-        6
-    }
-}
-
 #[test]
 fn typed_data_from_a_generated_struct() {
     let node = NodeId::new(5).unwrap();
@@ -374,8 +328,8 @@ fn typed_data_from_a_generated_struct() {
     t.set(
         ms(0),
         &Command {
-            control: 0x000F,
-            target: -2,
+            word: 0x000F,
+            long: -2,
         },
     )
     .unwrap();

@@ -80,9 +80,7 @@ impl SdoClient {
         crc: bool,
         block_size: u8,
     ) -> Result<(), Ended> {
-        if !self.is_ours(index, sub) {
-            return Err(self.fail(AbortCode::ParameterIncompatible));
-        }
+        self.check_ours(index, sub)?;
         self.start_sub_block(now, crc && self.config.crc, 0, block_size)
     }
 
@@ -124,11 +122,11 @@ impl SdoClient {
                 .saturating_mul(SEGMENT_BYTES)
                 .saturating_sub(self.out.fed());
             let crc = if crc { self.out.crc.value() } else { 0 };
-            self.send(Request::BlockDownloadEnd {
+            let request = Request::BlockDownloadEnd {
                 unused: unused as u8,
                 crc,
-            });
-            self.wait(now, Phase::BlockDownloadEnd);
+            };
+            self.request(now, request, Phase::BlockDownloadEnd);
             return Ok(());
         }
         let left = total.map_or(usize::MAX, |total| total.saturating_sub(confirmed));
@@ -181,9 +179,7 @@ impl SdoClient {
         crc: bool,
         size: Option<u32>,
     ) -> Result<(), Ended> {
-        if !self.is_ours(index, sub) {
-            return Err(self.fail(AbortCode::ParameterIncompatible));
-        }
+        self.check_ours(index, sub)?;
         let size = self.reserve_announced(size)?;
         self.send(Request::BlockUploadStart);
         self.wait(

@@ -80,9 +80,7 @@ impl SdoClient {
         sub: u8,
         data: Initiate,
     ) -> Result<(), Ended> {
-        if !self.is_ours(index, sub) {
-            return Err(self.fail(AbortCode::ParameterIncompatible));
-        }
+        self.check_ours(index, sub)?;
         match data {
             Initiate::Expedited { data, len } => {
                 let bytes = data.get(..usize::from(len.unwrap_or(4))).unwrap_or(&data);

@@ -155,44 +155,32 @@ impl SdoClient {
     ) -> Result<(), Busy> {
         self.start(index, sub)?;
         self.out.reset(true, size.map(|s| s as usize));
-        self.initiate_download(now, index, sub, size, method);
+        self.initiate_download(now, size, method);
         Ok(())
     }
 
     /// Sends the initiate of a segmented or block download (of the value in
     /// `self.out`): block with [`Method::Block`], or with [`Method::Auto`]
     /// when `block_download_above` is below the size.
-    pub(super) fn initiate_download(
-        &mut self,
-        now: Instant,
-        index: u16,
-        sub: u8,
-        size: Option<u32>,
-        method: Method,
-    ) {
-        let block = match method {
-            Method::Block => true,
-            Method::Auto => matches!(
-                (self.config.block_download_above, size),
-                (Some(above), Some(size)) if size as usize > above
-            ),
-            Method::Standard | Method::Segmented => false,
-        };
-        if block {
-            self.send(Request::BlockDownloadInitiate {
+    pub(super) fn initiate_download(&mut self, now: Instant, size: Option<u32>, method: Method) {
+        let (index, sub) = (self.index, self.sub);
+        let auto = matches!(
+            (self.config.block_download_above, size),
+            (Some(above), Some(size)) if size as usize > above
+        );
+        if method.is_block(auto) {
+            let crc = self.config.crc;
+            let request = Request::BlockDownloadInitiate {
                 index,
                 sub,
-                crc: self.config.crc,
+                crc,
                 size,
-            });
-            self.wait(now, Phase::BlockDownloadInitiate);
+            };
+            self.request(now, request, Phase::BlockDownloadInitiate);
         } else {
-            self.send(Request::DownloadInitiate {
-                index,
-                sub,
-                data: Initiate::Segmented { size },
-            });
-            self.wait(now, Phase::DownloadInitiate);
+            let data = Initiate::Segmented { size };
+            let request = Request::DownloadInitiate { index, sub, data };
+            self.request(now, request, Phase::DownloadInitiate);
         }
     }
 

@@ -8,8 +8,10 @@ mod stream;
 
 use super::*;
 use crate::frame::CanId;
+use crate::sdo::Channel;
 use crate::sdo::proto::ParseError;
 use crate::{Frame, Service};
+use core::time::Duration;
 
 const REQUEST: u16 = 0x601;
 const RESPONSE: u16 = 0x581;
@@ -485,24 +487,28 @@ fn unannounced_upload_stops_at_max_upload() {
 }
 
 #[test]
-fn four_gigabytes_announced_in_a_segmented_upload() {
-    let mut c = client();
-    c.upload(ms(0), 0x1F50, 1).unwrap();
-    sent(&mut c);
-    reply(
-        &mut c,
-        ms(1),
-        [0x41, 0x50, 0x1F, 0x01, 0xFF, 0xFF, 0xFF, 0xFF],
-    );
-    assert_eq!(
-        one(&mut c),
-        [0x80, 0x50, 0x1F, 0x01, 0x05, 0x00, 0x04, 0x05]
-    );
-    assert_eq!(
-        events(&mut c),
-        failed(0x1F50, 1, local(AbortCode::OutOfMemory))
-    );
-    assert_eq!(c.buf.capacity(), 0);
+fn four_gigabytes_announced_in_a_segmented_or_block_upload() {
+    // The initiate response with size 0xFFFFFFFF: segmented (scs=2, s=1:
+    // 0x41) and block (scs=6, s=1: 0xC2).
+    for (method, answer) in [(Method::Auto, 0x41), (Method::Block, 0xC2)] {
+        let mut c = client();
+        c.upload_with(ms(0), 0x1F50, 1, method).unwrap();
+        sent(&mut c);
+        reply(
+            &mut c,
+            ms(1),
+            [answer, 0x50, 0x1F, 0x01, 0xFF, 0xFF, 0xFF, 0xFF],
+        );
+        assert_eq!(
+            one(&mut c),
+            [0x80, 0x50, 0x1F, 0x01, 0x05, 0x00, 0x04, 0x05]
+        );
+        assert_eq!(
+            events(&mut c),
+            failed(0x1F50, 1, local(AbortCode::OutOfMemory))
+        );
+        assert_eq!(c.buf.capacity(), 0);
+    }
 }
 
 #[test]

@@ -3,7 +3,7 @@
 use super::super::proto::{BlockSegment, CRC, Request, Response};
 use super::{
     MAX_BLOCK_SIZE, ObjectStore, SEGMENT, SdoServer, ServerEvent, State, append_bounded,
-    length_error, offered_block_size, padded_len, segment_error,
+    offered_block_size, padded_len, segment_error,
 };
 use crate::sdo::AbortCode;
 
@@ -117,15 +117,11 @@ impl<S: ObjectStore> SdoServer<S> {
     /// Block download initiate: checks the size bound and the store, then
     /// offers the block size and the CRC.
     pub(super) fn block_download_initiate(&mut self, crc: bool, size: Option<u32>) {
-        let (index, sub) = self.object;
-        let size = match size.map(usize::try_from) {
-            None => None,
-            Some(Ok(size)) if size <= self.config.max_download => Some(size),
-            Some(_) => return self.fail(AbortCode::OutOfMemory),
+        let size = match self.download_size(size) {
+            Ok(size) => size,
+            Err(code) => return self.fail(code),
         };
-        if let Err(code) = self.store.check_write(index, sub, size) {
-            return self.fail(code);
-        }
+        let (index, sub) = self.object;
         let limit = padded_len(size.unwrap_or(self.config.max_download));
         if size.is_some() {
             self.buf.reserve_exact(limit);
@@ -209,19 +205,7 @@ impl<S: ObjectStore> SdoServer<S> {
         if agreed_crc && CRC.checksum(&self.buf) != crc {
             return self.fail(AbortCode::CrcError);
         }
-        if let Some(size) = size
-            && len != size
-        {
-            return self.fail(length_error(len, size));
-        }
-        let (index, sub) = self.object;
-        match self.store.write(index, sub, &self.buf) {
-            Ok(()) => {
-                self.send(Response::BlockDownloadEnd);
-                self.succeed(ServerEvent::Downloaded { index, sub, len });
-            }
-            Err(code) => self.fail(code),
-        }
+        self.complete_download(size, Response::BlockDownloadEnd);
     }
 
     /// Block upload initiate: checks the client's block size, reads the

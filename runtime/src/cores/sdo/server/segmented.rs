@@ -2,7 +2,7 @@
 //! upload" protocols).
 
 use super::super::proto::{Initiate, Response};
-use super::{ObjectStore, SEGMENT, SdoServer, ServerEvent, State, append_bounded, length_error};
+use super::{ObjectStore, SEGMENT, SdoServer, ServerEvent, State, append_bounded};
 use crate::sdo::AbortCode;
 
 impl<S: ObjectStore> SdoServer<S> {
@@ -31,14 +31,10 @@ impl<S: ObjectStore> SdoServer<S> {
                 }
             }
             Initiate::Segmented { size } => {
-                let size = match size.map(usize::try_from) {
-                    None => None,
-                    Some(Ok(size)) if size <= self.config.max_download => Some(size),
-                    Some(_) => return self.fail(AbortCode::OutOfMemory),
+                let size = match self.download_size(size) {
+                    Ok(size) => size,
+                    Err(code) => return self.fail(code),
                 };
-                if let Err(code) = self.store.check_write(index, sub, size) {
-                    return self.fail(code);
-                }
                 if let Some(size) = size {
                     self.buf.reserve_exact(size);
                 }
@@ -83,20 +79,7 @@ impl<S: ObjectStore> SdoServer<S> {
             self.send(Response::DownloadSegment { toggle });
             return;
         }
-        let len = self.buf.len();
-        if let Some(size) = size
-            && len != size
-        {
-            return self.fail(length_error(len, size));
-        }
-        let (index, sub) = self.object;
-        match self.store.write(index, sub, &self.buf) {
-            Ok(()) => {
-                self.send(Response::DownloadSegment { toggle });
-                self.succeed(ServerEvent::Downloaded { index, sub, len });
-            }
-            Err(code) => self.fail(code),
-        }
+        self.complete_download(size, Response::DownloadSegment { toggle });
     }
 
     /// Upload initiate: reads the value; up to 4 bytes go expedited, more

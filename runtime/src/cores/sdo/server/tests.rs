@@ -65,21 +65,27 @@ pub(super) fn failed(index: u16, sub: u8, error: SdoError) -> Vec<ServerEvent> {
     vec![ServerEvent::Failed { index, sub, error }]
 }
 
+pub(super) fn downloaded(index: u16, sub: u8, len: usize) -> Vec<ServerEvent> {
+    vec![ServerEvent::Downloaded { index, sub, len }]
+}
+
+pub(super) fn uploaded(index: u16, sub: u8, len: usize) -> Vec<ServerEvent> {
+    vec![ServerEvent::Uploaded { index, sub, len }]
+}
+
+/// The server is idle, waiting for nothing.
+pub(super) fn assert_idle(server: &SdoServer<MemoryStore>) {
+    assert!(server.is_idle());
+    assert_eq!(server.poll_timeout(), None);
+}
+
 #[test]
 fn expedited_upload_of_four_bytes() {
     let mut s = server();
     let out = exchange(&mut s, 0, [0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0]);
     assert_eq!(out, [[0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00]]);
-    assert_eq!(
-        events(&mut s),
-        [ServerEvent::Uploaded {
-            index: 0x1000,
-            sub: 0,
-            len: 4
-        }]
-    );
-    assert!(s.is_idle());
-    assert_eq!(s.poll_timeout(), None);
+    assert_eq!(events(&mut s), uploaded(0x1000, 0, 4));
+    assert_idle(&s);
 }
 
 #[test]
@@ -89,14 +95,7 @@ fn expedited_download_of_two_bytes() {
     let out = exchange(&mut s, 0, [0x2B, 0x17, 0x10, 0x00, 0xD0, 0x07, 0, 0]);
     assert_eq!(out, [[0x60, 0x17, 0x10, 0x00, 0, 0, 0, 0]]);
     assert_eq!(s.store().get(0x1017, 0), Some(&[0xD0, 0x07][..]));
-    assert_eq!(
-        events(&mut s),
-        [ServerEvent::Downloaded {
-            index: 0x1017,
-            sub: 0,
-            len: 2
-        }]
-    );
+    assert_eq!(events(&mut s), downloaded(0x1017, 0, 2));
 }
 
 #[test]
@@ -116,16 +115,8 @@ fn segmented_download_of_ten_bytes() {
     let out = exchange(&mut s, 20, [0x19, b'H', b'I', b'J', 0, 0, 0, 0]);
     assert_eq!(out, [[0x30, 0, 0, 0, 0, 0, 0, 0]]);
     assert_eq!(s.store().get(0x2000, 1), Some(&b"ABCDEFGHIJ"[..]));
-    assert_eq!(
-        events(&mut s),
-        [ServerEvent::Downloaded {
-            index: 0x2000,
-            sub: 1,
-            len: 10
-        }]
-    );
-    assert!(s.is_idle());
-    assert_eq!(s.poll_timeout(), None);
+    assert_eq!(events(&mut s), downloaded(0x2000, 1, 10));
+    assert_idle(&s);
 }
 
 #[test]
@@ -138,14 +129,7 @@ fn segmented_upload_of_ten_bytes() {
     assert!(events(&mut s).is_empty());
     let out = exchange(&mut s, 2, [0x70, 0, 0, 0, 0, 0, 0, 0]);
     assert_eq!(out, [[0x19, b'H', b'I', b'J', 0, 0, 0, 0]]);
-    assert_eq!(
-        events(&mut s),
-        [ServerEvent::Uploaded {
-            index: 0x1008,
-            sub: 0,
-            len: 10
-        }]
-    );
+    assert_eq!(events(&mut s), uploaded(0x1008, 0, 10));
     assert!(s.is_idle());
 }
 
@@ -157,14 +141,7 @@ fn empty_value_uploads_as_one_empty_segment() {
     // t=0, n=7, c=1: 0x0F.
     let out = exchange(&mut s, 1, [0x60, 0, 0, 0, 0, 0, 0, 0]);
     assert_eq!(out, [[0x0F, 0, 0, 0, 0, 0, 0, 0]]);
-    assert_eq!(
-        events(&mut s),
-        [ServerEvent::Uploaded {
-            index: 0x2000,
-            sub: 1,
-            len: 0
-        }]
-    );
+    assert_eq!(events(&mut s), uploaded(0x2000, 1, 0));
 }
 
 #[test]
@@ -181,8 +158,7 @@ fn wrong_toggle_aborts_downloads_and_uploads() {
             SdoError::LocalAbort(AbortCode::ToggleBitNotAlternated)
         )
     );
-    assert!(s.is_idle());
-    assert_eq!(s.poll_timeout(), None);
+    assert_idle(&s);
 
     exchange(&mut s, 2, [0x40, 0x08, 0x10, 0x00, 0, 0, 0, 0]);
     exchange(&mut s, 3, [0x60, 0, 0, 0, 0, 0, 0, 0]);
@@ -312,8 +288,7 @@ fn timeout_sends_the_timeout_abort() {
         [[0x80, 0x00, 0x20, 0x01, 0x00, 0x00, 0x04, 0x05]]
     );
     assert_eq!(events(&mut s), failed(0x2000, 1, SdoError::Timeout));
-    assert!(s.is_idle());
-    assert_eq!(s.poll_timeout(), None);
+    assert_idle(&s);
     // Later timeouts do nothing.
     s.handle_timeout(at(2000));
     assert!(drain(&mut s).is_empty());
@@ -338,8 +313,7 @@ fn client_abort_ends_the_transfer_silently() {
         events(&mut s),
         failed(0x2000, 1, SdoError::RemoteAbort(AbortCode::GeneralError))
     );
-    assert!(s.is_idle());
-    assert_eq!(s.poll_timeout(), None);
+    assert_idle(&s);
     // An abort with no transfer running is not answered.
     let out = exchange(&mut s, 2, [0x80, 0x00, 0x20, 0x01, 0x00, 0x00, 0x00, 0x08]);
     assert!(out.is_empty());
@@ -354,14 +328,7 @@ fn a_new_initiate_restarts_without_an_abort() {
     // The client starts over with an upload: served, the download dropped.
     let out = exchange(&mut s, 2, [0x40, 0x00, 0x10, 0x00, 0, 0, 0, 0]);
     assert_eq!(out, [[0x43, 0x00, 0x10, 0x00, 0x92, 0x01, 0x02, 0x00]]);
-    assert_eq!(
-        events(&mut s),
-        [ServerEvent::Uploaded {
-            index: 0x1000,
-            sub: 0,
-            len: 4
-        }]
-    );
+    assert_eq!(events(&mut s), uploaded(0x1000, 0, 4));
     assert_eq!(s.store().get(0x2000, 1), Some(&[][..]));
     // And a download restarted from its initiate starts from zero bytes.
     exchange(&mut s, 3, [0x21, 0x00, 0x20, 0x01, 3, 0, 0, 0]);

@@ -4,7 +4,9 @@
 
 use alloc::vec::Vec;
 
-use super::tests::{config, drain, events, exchange, failed, server, store};
+use super::tests::{
+    assert_idle, config, downloaded, drain, events, exchange, failed, server, store, uploaded,
+};
 use super::*;
 
 /// CRC-16 of block transfers, one bit at a time.
@@ -72,16 +74,8 @@ fn block_download_with_a_gap_is_re_requested() {
     let out = exchange(&mut s, 7, [0xD5, lo, hi, 0, 0, 0, 0, 0]);
     assert_eq!(out, [[0xA1, 0, 0, 0, 0, 0, 0, 0]]);
     assert_eq!(s.store().get(0x2000, 1), Some(&data[..]));
-    assert_eq!(
-        events(&mut s),
-        [ServerEvent::Downloaded {
-            index: 0x2000,
-            sub: 1,
-            len: 30
-        }]
-    );
-    assert!(s.is_idle());
-    assert_eq!(s.poll_timeout(), None);
+    assert_eq!(events(&mut s), downloaded(0x2000, 1, 30));
+    assert_idle(&s);
 }
 
 #[test]
@@ -220,16 +214,8 @@ fn block_upload_with_a_short_ack_resends() {
     assert!(events(&mut s).is_empty());
     // The client's end (0xA1) completes the upload.
     assert!(exchange(&mut s, 4, [0xA1, 0, 0, 0, 0, 0, 0, 0]).is_empty());
-    assert_eq!(
-        events(&mut s),
-        [ServerEvent::Uploaded {
-            index: 0x2000,
-            sub: 2,
-            len: 20
-        }]
-    );
-    assert!(s.is_idle());
-    assert_eq!(s.poll_timeout(), None);
+    assert_eq!(events(&mut s), uploaded(0x2000, 2, 20));
+    assert_idle(&s);
 }
 
 #[test]

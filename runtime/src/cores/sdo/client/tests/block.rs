@@ -260,28 +260,6 @@ fn block_upload_rejects_sequence_numbers_beyond_the_block_size() {
 }
 
 #[test]
-fn four_gigabytes_announced_in_a_block_upload() {
-    let mut c = client();
-    c.upload_with(ms(0), 0x1F50, 1, Method::Block).unwrap();
-    sent(&mut c);
-    // scs=6, s=1: size 0xFFFFFFFF.
-    reply(
-        &mut c,
-        ms(1),
-        [0xC2, 0x50, 0x1F, 0x01, 0xFF, 0xFF, 0xFF, 0xFF],
-    );
-    assert_eq!(
-        one(&mut c),
-        [0x80, 0x50, 0x1F, 0x01, 0x05, 0x00, 0x04, 0x05]
-    );
-    assert_eq!(
-        events(&mut c),
-        failed(0x1F50, 1, local(AbortCode::OutOfMemory))
-    );
-    assert_eq!(c.buf.capacity(), 0);
-}
-
-#[test]
 fn block_upload_without_size_stops_at_max_upload() {
     let mut c = SdoClient::new(ClientConfig {
         max_upload: 10,

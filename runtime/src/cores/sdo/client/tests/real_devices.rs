@@ -89,58 +89,38 @@ fn short_responses_are_taken_when_every_byte_they_need_is_there() {
 
 #[test]
 fn a_response_shorter_than_its_command_needs_names_the_frame() {
-    let mut c = client();
-    c.upload(ms(0), 0x1001, 0).unwrap();
-    sent(&mut c);
-    // 4F announces one data byte at offset 4; the frame ends before it.
-    reply_short(&mut c, ms(1), &[0x4F, 0x01, 0x10, 0x00]);
-    assert_eq!(
-        one(&mut c),
-        [0x80, 0x01, 0x10, 0x00, 0x01, 0x00, 0x04, 0x05]
-    );
-    let error = SdoError::BadResponse {
-        frame: [0x4F, 0x01, 0x10, 0x00, 0, 0, 0, 0],
-        len: 4,
-        error: ParseError::Short { len: 4, needed: 5 },
-    };
-    assert_eq!(events(&mut c), failed(0x1001, 0, error));
-    assert_eq!(
-        error.to_string(),
-        "the SDO server sent an invalid response [4F 01 10 00]: SDO response has 4 data bytes; \
-         its command needs at least 5; aborted with 0x05040001 (client/server command specifier not valid or unknown)"
-    );
-
-    // An abort frame needs its code: 8 bytes.
-    let mut c = client();
-    c.upload(ms(0), 0x1001, 0).unwrap();
-    sent(&mut c);
-    reply_short(&mut c, ms(1), &[0x80, 0x01, 0x10, 0x00, 0x00, 0x00]);
-    assert_eq!(
-        one(&mut c),
-        [0x80, 0x01, 0x10, 0x00, 0x01, 0x00, 0x04, 0x05]
-    );
-    let error = SdoError::BadResponse {
-        frame: [0x80, 0x01, 0x10, 0x00, 0, 0, 0, 0],
-        len: 6,
-        error: ParseError::Short { len: 6, needed: 8 },
-    };
-    assert_eq!(events(&mut c), failed(0x1001, 0, error));
-
-    // An empty frame.
-    let mut c = client();
-    c.upload(ms(0), 0x1001, 0).unwrap();
-    sent(&mut c);
-    reply_short(&mut c, ms(1), &[]);
-    assert_eq!(
-        events(&mut c),
-        failed(
-            0x1001,
-            0,
-            SdoError::BadResponse {
-                frame: [0; 8],
-                len: 0,
-                error: ParseError::Short { len: 0, needed: 1 },
-            }
-        )
-    );
+    // 4F announces one data byte at offset 4, the frame ends before it; an
+    // abort frame needs its code (8 bytes); an empty frame, its command.
+    for (short, needed) in [
+        (&[0x4F, 0x01, 0x10, 0x00][..], 5),
+        (&[0x80, 0x01, 0x10, 0x00, 0x00, 0x00][..], 8),
+        (&[][..], 1),
+    ] {
+        let mut c = client();
+        c.upload(ms(0), 0x1001, 0).unwrap();
+        sent(&mut c);
+        reply_short(&mut c, ms(1), short);
+        if !short.is_empty() {
+            assert_eq!(
+                one(&mut c),
+                [0x80, 0x01, 0x10, 0x00, 0x01, 0x00, 0x04, 0x05]
+            );
+        }
+        let mut frame = [0u8; 8];
+        frame[..short.len()].copy_from_slice(short);
+        let len = short.len();
+        let error = SdoError::BadResponse {
+            frame,
+            len: len as u8,
+            error: ParseError::Short { len, needed },
+        };
+        assert_eq!(events(&mut c), failed(0x1001, 0, error));
+        if len == 4 {
+            assert_eq!(
+                error.to_string(),
+                "the SDO server sent an invalid response [4F 01 10 00]: SDO response has 4 data bytes; \
+                 its command needs at least 5; aborted with 0x05040001 (client/server command specifier not valid or unknown)"
+            );
+        }
+    }
 }
