@@ -21,6 +21,16 @@ pub fn seed(name: &str) -> Arc<eds2rust::ir::Device> {
     Arc::new(loaded.device.expect("a device"))
 }
 
+/// A decoder that knows the nodes `nodes` by `eds/<name>.yaml`.
+pub fn seed_decoder(name: &str, nodes: &[u8]) -> Decoder {
+    let device = seed(name);
+    let mut decoder = Decoder::new();
+    for node in nodes {
+        decoder.add_node(*node, device.clone());
+    }
+    decoder
+}
+
 /// Every record of `trace` (one frame a line) as JSON.
 pub fn decode(decoder: &mut Decoder, trace: &[String]) -> Vec<Json> {
     let text = trace.join("\n");
