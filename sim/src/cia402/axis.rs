@@ -8,7 +8,9 @@
 use std::time::Duration;
 
 use eds2rust_runtime::Instant;
-use eds2rust_runtime::cia402::{DeviceEvent, DeviceStateMachine, ModeOfOperation, State};
+use eds2rust_runtime::cia402::{
+    DeviceConfig as MachineConfig, DeviceEvent, DeviceStateMachine, ModeOfOperation, State,
+};
 
 use super::profiler::Profiler;
 
@@ -66,6 +68,23 @@ impl Axis {
             outside_since: None,
             inside_since: None,
         }
+    }
+
+    /// Power-on (and NMT reset node): no state machine until the next
+    /// input ([`Axis::switch_on`]); the axis stays where it is.
+    pub(crate) fn power_off(&mut self) {
+        self.sm = None;
+        self.last = None;
+        self.stop_motion();
+    }
+
+    /// The first input after power-on: a new state machine with `config`
+    /// in `mode`; the mechanics run from `now`.
+    pub(crate) fn switch_on(&mut self, now: Instant, config: MachineConfig, mode: ModeOfOperation) {
+        let mut sm = DeviceStateMachine::new(now, config);
+        sm.set_mode(mode);
+        self.sm = Some(sm);
+        self.last = Some(now);
     }
 
     /// The mechanics `factor` times faster than real time (a factor that

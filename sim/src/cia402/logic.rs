@@ -48,11 +48,10 @@ impl Cia402 {
     /// Power-on (and NMT reset node): a new state machine; the axis stays
     /// where it is.
     pub(super) fn power_on(&mut self, ctx: Ctx<'_, '_>) {
-        self.axis.sm = None;
-        self.axis.last = None;
+        self.homing_in_place = None;
+        self.axis.power_off();
         self.option_code_changed = false;
         self.emcy_sent = false;
-        self.stop_motion();
         self.begin(ctx);
         self.finish(ctx);
     }
@@ -71,11 +70,9 @@ impl Cia402 {
                         .then_some(1)
                 })
                 .unwrap_or(0);
-            let code = obj::quick_stop_option_code(table);
-            let mut sm = DeviceStateMachine::new(ctx.now(), machine_config(code));
-            sm.set_mode(ModeOfOperation::from_i8(mode as i8));
-            self.axis.sm = Some(sm);
-            self.axis.last = Some(ctx.now());
+            let config = machine_config(obj::quick_stop_option_code(table));
+            let mode = ModeOfOperation::from_i8(mode as i8);
+            self.axis.switch_on(ctx.now(), config, mode);
         }
         self.advance(ctx);
     }

@@ -1,14 +1,35 @@
 //! The workings of [`ZimmerAcs`]: the state machine's events and their
 //! effects, set-points, the mechanics, the monitors, and what is published
 //! in the object table.
+//!
+//! What the manual and CiA 402 agree on is the shared axis
+//! ([`crate::cia402::axis`]: state machine, trajectory generator,
+//! set-points, settling, fault raise and reset). What stays here is where
+//! the manual says something of its own:
+//! - 0x6060 (11.1.2, 15.5 "The default value is 1"): only 1 and 8 exist, so no
+//!   homing starts and no other mode runs.
+//! - Statusword bit 4 (the LED table: "StatusWord Bit 04 (Voltage enabled) = 1 ⇒
+//!   Regler ist aktiv") is the power stage with STO (16.1.3), and bit 9
+//!   is not set: the state machine sets neither.
+//! - 0x605A (15.5): 0, 1, 2, 5, 6; "Slow down ramp uses deceleration
+//!   defined in PROFILE_DECELERATION, while Quick stop ramp uses
+//!   LIM_DECELERATION_MAX" (0x300A sub 2) for 0x605A and 0x605D.
+//! - Transition 15 (15.1.1): "Nach dem Verlassen des Fehlerzustands wird
+//!   der Befehl Fault reset im ControlWord vom Steuergerät gelöscht".
+//! - Target reached (15.1.2.1) "benötigt ein konfiguriertes
+//!   Positionsfenster und eine konfigurierte Zeit": the window is 0x21F1,
+//!   the time [`POSITION_WINDOW_TIME`](super::POSITION_WINDOW_TIME).
+//! - A following error (15.5 0x6065) is error 0x7387 (Fault), a profile
+//!   with a zero value is 0x7391 ("they should all have positive
+//!   values"), enabling outside the position limits 0x3007 in a position
+//!   mode is an error (15.4); every error is "power stage shutdown".
 
 use std::time::Duration;
 
 use eds2rust_drivers::zimmer_acs::errors::{ZimmerErrors, ZimmerErrorsCode};
 use eds2rust_drivers::zimmer_acs::od;
 use eds2rust_runtime::cia402::{
-    Controlword, DeviceConfig as MachineConfig, DeviceEvent, DeviceStateMachine, ModeOfOperation,
-    State,
+    Controlword, DeviceConfig as MachineConfig, DeviceEvent, ModeOfOperation, State,
 };
 
 use super::factory::{self, RAMP_MAX};
@@ -48,9 +69,7 @@ impl ZimmerAcs {
     /// values where nothing was saved, the volatile entries at 0. The
     /// carriage stays where it is.
     pub(super) fn power_on(&mut self, ctx: Ctx<'_, '_>) {
-        self.axis.sm = None;
-        self.axis.last = None;
-        self.stop_motion();
+        self.axis.power_off();
         self.angle_determined = false;
         self.clamp_released = false;
         self.sto_latched = false;
@@ -67,10 +86,8 @@ impl ZimmerAcs {
     pub(super) fn begin(&mut self, ctx: Ctx<'_, '_>) {
         if self.axis.sm.is_none() {
             let mode = ctx.get::<od::ModesOfOperation>().map_or(1, |v| v.0);
-            let mut sm = DeviceStateMachine::new(ctx.now(), machine_config());
-            sm.set_mode(ModeOfOperation::from_i8(mode));
-            self.axis.sm = Some(sm);
-            self.axis.last = Some(ctx.now());
+            let mode = ModeOfOperation::from_i8(mode);
+            self.axis.switch_on(ctx.now(), machine_config(), mode);
         }
         self.advance(ctx);
     }
