@@ -94,6 +94,24 @@ fn model_events(b: &mut Bench<ZimmerAcs>) -> Vec<ZimmerAcsEvent> {
         .collect()
 }
 
+/// The state machine's transitions (CiA 402 numbers) since the last call.
+fn transitions(b: &mut Bench<ZimmerAcs>) -> Vec<u8> {
+    model_events(b)
+        .into_iter()
+        .filter_map(|e| match e {
+            ZimmerAcsEvent::StateChanged { transition, .. } => Some(transition),
+            _ => None,
+        })
+        .collect()
+}
+
+/// The STO inputs (true = 24 V).
+fn set_sto(b: &mut Bench<ZimmerAcs>, sto1: bool, sto2: bool) {
+    let now = b.now();
+    b.device
+        .with_model(now, |m, ctx| m.set_sto(ctx, sto1, sto2));
+}
+
 fn frames_with_id(b: &Bench<ZimmerAcs>, start: usize, id: &str) -> Vec<String> {
     lines_from(b, start)
         .into_iter()
@@ -146,14 +164,7 @@ fn boots_at_node_40_and_enables_with_6_7_15_over_sdo() {
     assert!(b.device.behaviour().clamp_released());
     // Mode of operation: 1 (profile position) by default (15.5).
     assert_eq!(read(&mut b, 0x6061, 0), [1]);
-    let transitions: Vec<u8> = model_events(&mut b)
-        .into_iter()
-        .filter_map(|e| match e {
-            ZimmerAcsEvent::StateChanged { transition, .. } => Some(transition),
-            _ => None,
-        })
-        .collect();
-    assert_eq!(transitions, [0, 1, 2, 3, 4]);
+    assert_eq!(transitions(&mut b), [0, 1, 2, 3, 4]);
 }
 
 #[test]
@@ -287,9 +298,7 @@ fn sto_dropping_in_operation_enabled_is_0x3283_and_blocks_switching_on() {
     assert_eq!(read(&mut b, 0x251A, 0), [0x17, 0x00]);
     enable(&mut b);
     let start = b.trace.len();
-    let now = b.now();
-    b.device
-        .with_model(now, |m, ctx| m.set_sto(ctx, false, false));
+    set_sto(&mut b, false, false);
     b.run_for(ms(1));
     assert_eq!(frames_with_id(&b, start, "0A8#"), ["0A8#8332000000000000"]);
     // Fault, no voltage (bit 4 = 0, status LED blue/red, 11.3).
@@ -305,9 +314,7 @@ fn sto_dropping_in_operation_enabled_is_0x3283_and_blocks_switching_on() {
     assert_eq!(frames_with_id(&b, start, "0A8#"), ["0A8#8032000000000000"]);
     assert_eq!(statusword(&mut b), 0x4008);
     // Inputs back: reset and enable work again.
-    let now = b.now();
-    b.device
-        .with_model(now, |m, ctx| m.set_sto(ctx, true, true));
+    set_sto(&mut b, true, true);
     controlword(&mut b, 0x80);
     enable(&mut b);
     assert_eq!(statusword(&mut b), 0x4437);
@@ -316,9 +323,7 @@ fn sto_dropping_in_operation_enabled_is_0x3283_and_blocks_switching_on() {
 #[test]
 fn differing_sto_inputs_latch_0x3282_until_power_on() {
     let mut b = bench();
-    let now = b.now();
-    b.device
-        .with_model(now, |m, ctx| m.set_sto(ctx, true, false));
+    set_sto(&mut b, true, false);
     b.run_for(ms(10));
     // STO1, supply OK, abnormal fault; no report (16.1.3 irregular STO).
     assert_eq!(read(&mut b, 0x251A, 0), [0x0D, 0x00]);
@@ -328,9 +333,7 @@ fn differing_sto_inputs_latch_0x3282_until_power_on() {
     assert_eq!(frames_with_id(&b, start, "0A8#"), ["0A8#8232000000000000"]);
     assert_eq!(statusword(&mut b), 0x0008);
     // Latched: inputs back high, fault reset refused.
-    let now = b.now();
-    b.device
-        .with_model(now, |m, ctx| m.set_sto(ctx, true, true));
+    set_sto(&mut b, true, true);
     controlword(&mut b, 0x80);
     assert_eq!(statusword(&mut b), 0x0008);
     // Report = NOR(STO1, STO2) = 0, abnormal fault stays.
@@ -490,14 +493,7 @@ fn quick_stop_ramps_down_then_disables() {
     assert_eq!(statusword(&mut b), 0x4040);
     let stopped = position(&mut b);
     assert!(stopped >= moving && stopped < 90_000);
-    let transitions: Vec<u8> = model_events(&mut b)
-        .into_iter()
-        .filter_map(|e| match e {
-            ZimmerAcsEvent::StateChanged { transition, .. } => Some(transition),
-            _ => None,
-        })
-        .collect();
-    assert_eq!(transitions, [11, 12]);
+    assert_eq!(transitions(&mut b), [11, 12]);
 }
 
 #[test]
