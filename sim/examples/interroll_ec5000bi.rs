@@ -32,7 +32,7 @@ use eds2rust_sim::models::interroll_ec5000bi::{
 #[path = "common/mod.rs"]
 mod common;
 
-use common::Res;
+use common::{Res, node};
 
 type M = common::Master;
 
@@ -66,10 +66,6 @@ pub struct Summary {
 
 fn main() -> ExitCode {
     common::main("interroll_ec5000bi", run)
-}
-
-fn node(n: u8) -> Res<NodeId> {
-    NodeId::new(n).ok_or_else(|| format!("{n} is not a node id").into())
 }
 
 /// Reads entry `E` of `n`, naming it in the error.

@@ -33,7 +33,6 @@ use eds2rust_runtime::blocking;
 use eds2rust_runtime::emcy::EmcyEvent;
 use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::nmt::{NmtCommand, NmtEvent, NmtState};
-use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::od::Scaled as _;
 use eds2rust_sim::harness::{Args, Harness};
 use eds2rust_sim::models::linak_techline::{LinakTechline, NODE, default_config, simulator_with};
@@ -97,7 +96,7 @@ pub fn run(args: &Args, out: &mut dyn Write) -> Result<Summary> {
             now,
         )
     })?;
-    let me = NodeId::new(MASTER_NODE).ok_or_else(|| ScenarioError("master node id".into()))?;
+    let me = common::node(MASTER_NODE)?;
     let mut core = master::Master::new(me, Some(MASTER_HEARTBEAT));
     core.heartbeat.set_state(NmtState::Operational);
     // A stroke takes about 10 s at 5 mm/s; a real actuator may be longer

@@ -37,13 +37,12 @@ use eds2rust_machine::{actuator, axis, conveyor};
 use eds2rust_runtime::blocking;
 use eds2rust_runtime::boot::{Configuration, NetworkEvent, NetworkReport};
 use eds2rust_runtime::master::{self, MasterEvent};
-use eds2rust_runtime::od::NodeId;
 use eds2rust_sim::DeviceConfig;
 use eds2rust_sim::harness::{Args, Harness, MasterPort};
 use eds2rust_sim::models::{interroll_ec5000bi, linak_techline, zimmer_acs};
 use sequences::{ActuatorStroke, AxisMove, ConveyorRun, log};
 
-use common::Res;
+use common::{Res, node};
 
 /// The axis's move in the cycle, µm.
 pub const AXIS_DISTANCE_UM: i32 = 40_000;
@@ -77,10 +76,6 @@ pub struct Summary {
 
 fn main() -> ExitCode {
     common::main("machine", run)
-}
-
-fn node(id: u8) -> Res<NodeId> {
-    NodeId::new(id).ok_or_else(|| format!("node id {id}").into())
 }
 
 /// The three simulators on the harness's bus, at the node ids of the bus

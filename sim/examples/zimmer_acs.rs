@@ -30,7 +30,7 @@ use eds2rust_runtime::cia402::{
 use eds2rust_runtime::emcy::EmcyEvent;
 use eds2rust_runtime::master::{self, MasterEvent};
 use eds2rust_runtime::nmt::NmtCommand;
-use eds2rust_runtime::od::{Entry, NodeId};
+use eds2rust_runtime::od::Entry;
 use eds2rust_runtime::pdo::PdoEvent;
 use eds2rust_sim::harness::{Args, Harness};
 use eds2rust_sim::models::zimmer_acs::{self, NODE, ZimmerAcs};
@@ -95,7 +95,7 @@ pub fn run(args: &Args, out: &mut dyn std::io::Write) -> Result<Summary, Box<dyn
         let model = ZimmerAcs::new().with_time_scale(scale);
         zimmer_acs::simulator_with(model, zimmer_acs::default_config(), now)
     })?;
-    let me = NodeId::new(MASTER_NODE).ok_or_else(|| fail("bad master node id".into()))?;
+    let me = common::node(MASTER_NODE)?;
     let core = master::Master::new(me, None);
     let ((position_um, state, states), trace) = common::run_master(harness, core, |master| {
         let mut session = Session {

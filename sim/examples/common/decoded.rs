@@ -47,6 +47,14 @@ pub fn decode(decoder: &mut Decoder, trace: &[String]) -> Vec<Json> {
     records
 }
 
+/// Every record of `trace` decoded with `eds/<name>.yaml` at `nodes`,
+/// each a valid frame ([`assert_every_frame_decodes`]).
+pub fn decode_seed(name: &str, nodes: &[u8], trace: &[String]) -> Vec<Json> {
+    let records = decode(&mut seed_decoder(name, nodes), trace);
+    assert_every_frame_decodes(&records);
+    records
+}
+
 /// Every frame is a valid CANopen frame of a known kind, every PDO has
 /// its mapping and every SDO transfer names a table entry and its value.
 /// (The trace has no frame the decoder could not know: the master's and

@@ -14,6 +14,7 @@ use std::error::Error;
 use std::io::Write;
 use std::process::ExitCode;
 
+use eds2rust_runtime::od::NodeId;
 use eds2rust_runtime::{blocking, master};
 use eds2rust_sim::harness::{Args, Harness, MasterPort};
 
@@ -26,6 +27,11 @@ pub type Res<T> = Result<T, Box<dyn Error>>;
 
 /// The blocking master on the harness's bus.
 pub type Master = blocking::Master<MasterPort>;
+
+/// Node id `id`, or an error naming it.
+pub fn node(id: u8) -> Res<NodeId> {
+    NodeId::new(id).ok_or_else(|| format!("{id} is not a node id").into())
+}
 
 /// An example's `main`: the arguments (a bad command line prints the
 /// usage, exit code 2), then `run` printing to stdout (a failure prints

@@ -103,11 +103,11 @@ fn the_trace_decodes_to_the_printed_values() {
     // Slow enough that the velocity is printed during the ramp.
     let (summary, text) = run_at(2.0, run);
     println!("{text}");
-    let records = decode(
-        &mut seed_decoder("interroll_ec5000bi", &[DEFAULT_NODE_ID, NEW_NODE]),
+    let records = decode_seed(
+        "interroll_ec5000bi",
+        &[DEFAULT_NODE_ID, NEW_NODE],
         &summary.trace,
     );
-    assert_every_frame_decodes(&records);
     let (old, new) = (DEFAULT_NODE_ID, NEW_NODE);
     let text_of = |i: usize| records[i]["text"].as_str().expect("text");
     // The master does one thing at a time: every printed line is

@@ -157,11 +157,7 @@ fn the_trace_decodes_to_the_printed_values() {
     // (every 100 ms of the half-second move).
     let (summary, text) = run_at(2.0, run);
     println!("{text}");
-    let records = decode(
-        &mut seed_decoder("zimmer_acs", &[NODE.get()]),
-        &summary.trace,
-    );
-    assert_every_frame_decodes(&records);
+    let records = decode_seed("zimmer_acs", &[NODE.get()], &summary.trace);
     let seen = seen(&records);
     let seen_from = |from: usize, what: &str, accept: &dyn Fn(&Seen) -> bool| -> &Seen {
         seen.iter()

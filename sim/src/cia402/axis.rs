@@ -12,7 +12,7 @@ use eds2rust_runtime::cia402::{
     DeviceConfig as MachineConfig, DeviceEvent, DeviceStateMachine, ModeOfOperation, State,
 };
 
-use super::profiler::Profiler;
+use super::profiler::{Goal, Profiler};
 
 /// The state machine, the mechanics and the set-points of one axis.
 #[derive(Debug, Clone)]
@@ -139,6 +139,24 @@ impl Axis {
             .map_or(Duration::ZERO, |last| now.saturating_duration_since(last));
         self.last = Some(now);
         elapsed.as_secs_f64() * self.time_scale
+    }
+
+    /// Quick stop active: the generator brakes with `deceleration`; at
+    /// rest the quick stop completes (transition 12) unless the option
+    /// code keeps the drive in Quick stop active (`stays`).
+    pub(crate) fn brake_quick_stop(
+        &mut self,
+        now: Instant,
+        seconds: f64,
+        deceleration: f64,
+        stays: bool,
+    ) {
+        if self.profiler.run(seconds, Goal::Stop { deceleration })
+            && !stays
+            && let Some(sm) = self.sm.as_mut()
+        {
+            sm.complete_quick_stop(now);
+        }
     }
 
     /// The state machine's events since the last call.

@@ -228,15 +228,9 @@ impl Cia402 {
                         sm.config().stays_in_quick_stop(),
                     )
                 });
-                let goal = Goal::Stop {
-                    deceleration: obj::braking(ctx.table(), i64::from(code)),
-                };
-                if self.axis.profiler.run(seconds, goal)
-                    && !stays
-                    && let Some(sm) = self.axis.sm.as_mut()
-                {
-                    sm.complete_quick_stop(now);
-                }
+                let deceleration = obj::braking(ctx.table(), i64::from(code));
+                self.axis
+                    .brake_quick_stop(now, seconds, deceleration, stays);
             }
             _ => self.stop_motion(),
         }

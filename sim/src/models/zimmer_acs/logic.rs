@@ -305,17 +305,12 @@ impl ZimmerAcs {
             Some(State::QuickStopActive) => {
                 let code = ctx.get::<od::QuickStopOptionCode>().map_or(2, |v| v.0);
                 let quick = matches!(code, 2 | 6);
-                let goal = Goal::Stop {
-                    deceleration: self.ramp(ctx, quick),
-                };
+                let deceleration = self.ramp(ctx, quick);
                 // 15.5: options 0..2 disable the drive after the ramp (12),
                 // 5 and 6 stay in Quick stop active.
-                if self.axis.profiler.run(seconds, goal)
-                    && matches!(code, 0..=2)
-                    && let Some(sm) = self.axis.sm.as_mut()
-                {
-                    sm.complete_quick_stop(now);
-                }
+                let stays = !matches!(code, 0..=2);
+                self.axis
+                    .brake_quick_stop(now, seconds, deceleration, stays);
             }
             _ => self.stop_motion(),
         }
