@@ -94,6 +94,15 @@ fn has(b: &Bench<Ec5000Bi>, line: &str) -> bool {
     lines(b).iter().any(|l| l == line)
 }
 
+/// When the frames with CAN id `id` (`1FF#`) were sent.
+fn sent_at(b: &Bench<Ec5000Bi>, id: &str) -> Vec<Instant> {
+    b.trace
+        .iter()
+        .filter(|(_, f)| f.to_string().starts_with(id))
+        .map(|(t, _)| *t)
+        .collect()
+}
+
 #[test]
 fn delivered_at_node_127_with_its_identity() {
     let mut b = bench(1.0);
@@ -438,12 +447,7 @@ fn tpdos_follow_chapter_8() {
     assert!(has(&b, "3FF#500200000000"));
     // Event timer 2000 ms: sent again without a change.
     b.run_for(Duration::from_millis(2100));
-    let tpdo1: Vec<Instant> = b
-        .trace
-        .iter()
-        .filter(|(_, f)| f.to_string().starts_with("1FF#"))
-        .map(|(t, _)| *t)
-        .collect();
+    let tpdo1 = sent_at(&b, "1FF#");
     assert_eq!(tpdo1.len(), 2);
     assert_eq!(
         tpdo1[1].saturating_duration_since(tpdo1[0]),
@@ -455,12 +459,7 @@ fn tpdos_follow_chapter_8() {
     controlword(&mut b, N127, 0x0007);
     controlword(&mut b, N127, 0x000F);
     b.run_for(Duration::from_millis(300));
-    let times: Vec<Instant> = b
-        .trace
-        .iter()
-        .filter(|(_, f)| f.to_string().starts_with("1FF#"))
-        .map(|(t, _)| *t)
-        .collect();
+    let times = sent_at(&b, "1FF#");
     assert!(times.len() >= 2);
     for w in times.windows(2) {
         assert!(w[1].saturating_duration_since(w[0]) >= Duration::from_millis(100));

@@ -89,6 +89,11 @@ fn tpdos_since(b: &B, from: usize) -> Vec<String> {
         .collect()
 }
 
+/// The last TPDO1 on the bus.
+fn last_tpdo(b: &B) -> Option<String> {
+    tpdos_since(b, 0).pop()
+}
+
 fn read(b: &mut B, index: u16, sub: u8) -> Vec<u8> {
     b.upload(NODE, index, sub)
         .unwrap_or_else(|e| panic!("read {index:#06X}/{sub}: {e:?}"))
@@ -202,10 +207,7 @@ fn runs_to_a_position_and_stops_on_an_invalid_value() {
     // 20.0 mm = 200 = 0x00C8: standing there, no end stop, status 0x80.
     rpdo(&mut b, [0xC8, 0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(1000));
-    assert_eq!(
-        tpdos_since(&b, 0).last().map(String::as_str),
-        Some("1A0#C8000080000000C0")
-    );
+    assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#C8000080000000C0"));
     // Run out, then 0xFB06 (invalid): the actuator ramps down and stays.
     rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(200));
@@ -268,10 +270,7 @@ fn power_up_lock_refuses_runs_until_stop() {
     // Clear error (0xFB00) releases it as well as Stop does.
     rpdo(&mut b, [0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(20));
-    assert_eq!(
-        tpdos_since(&b, 0).last().map(String::as_str),
-        Some("1A0#00000081000000C0")
-    );
+    assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#00000081000000C0"));
     // Leaving and entering Operational arms the lock again (p. 27).
     nmt(&mut b, NmtCommand::EnterPreOperational);
     let mark = b.trace.len();
@@ -380,20 +379,14 @@ fn obstacle_trips_the_current_limit() {
     rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(1000));
     // Stopped at 20.0 mm (0x00C8), status 0x84 (overcurrent), error 0.
-    assert_eq!(
-        tpdos_since(&b, 0).last().map(String::as_str),
-        Some("1A0#C8000084000000C0")
-    );
+    assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#C8000084000000C0"));
     assert_eq!(read(&mut b, 0x4000, 0x1C), [1]); // default limit, out
     assert_eq!(read(&mut b, 0x4000, 0x26), [0x08, 0x00]); // reason 8
     assert_eq!(read(&mut b, 0x4000, 0x10), [16]); // 4.0 A peak
     // Run in is allowed (no error code) and clears the flag.
     rpdo(&mut b, [0x02, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(1000));
-    assert_eq!(
-        tpdos_since(&b, 0).last().map(String::as_str),
-        Some("1A0#00000081000000C0")
-    );
+    assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#00000081000000C0"));
     // A user limit of 1.0 A (0x04) is below the running current: cut off at
     // once, counted as a user-limit overload (0x4000 sub 0x1E).
     rpdo(&mut b, [0x01, 0xFB, 0x04, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
@@ -463,11 +456,11 @@ fn speed_setting_scales_the_feedback_speed() {
     // Speed 0x64 = 100 × 0.5 % = 50 %: 2.5 mm/s = 0x0019 in 0.1 mm/s.
     rpdo(&mut b, [0x01, 0xFB, 0xFB, 0x64, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(1000));
-    let last = tpdos_since(&b, 0).last().cloned().unwrap_or_default();
+    let last = last_tpdo(&b).unwrap_or_default();
     assert_eq!(&last[8..18], "0688001900", "{last}");
     // Changed during the run (p. 26): 100 % again, 5.0 mm/s.
     rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xC8, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(600));
-    let last = tpdos_since(&b, 0).last().cloned().unwrap_or_default();
+    let last = last_tpdo(&b).unwrap_or_default();
     assert_eq!(&last[8..18], "0688003200", "{last}");
 }
