@@ -105,6 +105,13 @@ fn transitions(b: &mut Bench<ZimmerAcs>) -> Vec<u8> {
         .collect()
 }
 
+/// A new set-point: the target `target_um` (0x607A), then controlword
+/// `cw` with bit 4 (and bit 5 or 6 as `cw` says).
+fn set_point(b: &mut Bench<ZimmerAcs>, target_um: i32, cw: u16) {
+    write(b, 0x607A, 0, &target_um.to_le_bytes());
+    controlword(b, cw);
+}
+
 /// The STO inputs (true = 24 V).
 fn set_sto(b: &mut Bench<ZimmerAcs>, sto1: bool, sto2: bool) {
     let now = b.now();
@@ -214,22 +221,19 @@ fn profile_position_move_with_the_set_point_handshake() {
 fn relative_targets_and_targets_beyond_the_stroke() {
     let mut b = bench_with(ZimmerAcs::new().with_time_scale(10.0));
     enable(&mut b);
-    write(&mut b, 0x607A, 0, &30_000i32.to_le_bytes());
-    controlword(&mut b, 0x1F);
+    set_point(&mut b, 30_000, 0x1F);
     controlword(&mut b, 0x0F);
     b.run_for(ms(200));
     assert_eq!(position(&mut b), 30_000);
     // Relative (bit 6): +25 mm from the last target.
-    write(&mut b, 0x607A, 0, &25_000i32.to_le_bytes());
-    controlword(&mut b, 0x5F);
+    set_point(&mut b, 25_000, 0x5F);
     controlword(&mut b, 0x4F);
     b.run_for(ms(200));
     assert_eq!(position(&mut b), 55_000);
     assert_eq!(statusword(&mut b) & 0x0800, 0);
     // 150 mm on an ACS40 (100 mm stroke): clamped to 0x3007/2, bit 11.
     assert_eq!(read(&mut b, 0x3007, 2), 100_000i32.to_le_bytes());
-    write(&mut b, 0x607A, 0, &150_000i32.to_le_bytes());
-    controlword(&mut b, 0x1F);
+    set_point(&mut b, 150_000, 0x1F);
     controlword(&mut b, 0x0F);
     b.run_for(ms(200));
     assert_eq!(position(&mut b), 100_000);
@@ -359,8 +363,7 @@ fn the_clamping_element_follows_the_state_machine_unless_overridden() {
     write(&mut b, 0x2129, 0, &[2, 0]);
     enable(&mut b);
     assert!(!b.device.behaviour().clamp_released());
-    write(&mut b, 0x607A, 0, &20_000i32.to_le_bytes());
-    controlword(&mut b, 0x1F);
+    set_point(&mut b, 20_000, 0x1F);
     b.run_for(ms(300));
     // Fault, following error, angle found; the acknowledge went with
     // Operation enabled.
@@ -425,8 +428,7 @@ fn store_and_restore_take_only_their_signatures() {
 fn the_position_survives_a_power_cycle_and_the_controlword_does_not() {
     let mut b = bench_with(ZimmerAcs::new().with_time_scale(10.0));
     enable(&mut b);
-    write(&mut b, 0x607A, 0, &12_345i32.to_le_bytes());
-    controlword(&mut b, 0x1F);
+    set_point(&mut b, 12_345, 0x1F);
     b.run_for(ms(200));
     write(&mut b, 0x1010, 1, b"save");
     let now = b.now();
@@ -480,8 +482,7 @@ fn modes_and_option_codes_outside_the_manual_are_refused() {
 fn quick_stop_ramps_down_then_disables() {
     let mut b = bench_with(ZimmerAcs::new().with_time_scale(2.0));
     enable(&mut b);
-    write(&mut b, 0x607A, 0, &90_000i32.to_le_bytes());
-    controlword(&mut b, 0x1F);
+    set_point(&mut b, 90_000, 0x1F);
     b.run_for(ms(200));
     let moving = position(&mut b);
     assert!(moving > 0 && moving < 90_000);
