@@ -89,6 +89,12 @@ fn tpdos_since(b: &B, from: usize) -> Vec<String> {
         .collect()
 }
 
+/// `frame` was on the bus since trace line `mark`.
+fn assert_sent_since(b: &B, mark: usize, frame: &str) {
+    let lines = lines_since(b, mark);
+    assert!(lines.iter().any(|l| l == frame), "{frame} not in {lines:?}");
+}
+
 /// The last TPDO1 on the bus.
 fn last_tpdo(b: &B) -> Option<String> {
     tpdos_since(b, 0).pop()
@@ -316,11 +322,7 @@ fn heartbeat_loss_stops_sets_error_5_and_sends_emcy_0x8130() {
     let mark = b.trace.len();
     rpdo(&mut b, [0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(20));
-    let lines = lines_since(&b, mark);
-    assert!(
-        lines.contains(&"0A0#0000000000000000".to_string()),
-        "{lines:?}"
-    );
+    assert_sent_since(&b, mark, "0A0#0000000000000000");
     assert_eq!(read(&mut b, 0x2001, 4), [0x00]);
     assert_eq!(read(&mut b, 0x1001, 0), [0x00]);
     // Stop reason 2048 "communication interrupted" (p. 46), one
@@ -337,13 +339,9 @@ fn jammed_spindle_is_error_12_with_emcy_0xff05() {
     let mark = b.trace.len();
     rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(200));
-    let lines = lines_since(&b, mark);
     // Code 0xFF05 "position does not change", register 0x81 (generic +
     // manufacturer); feedback error 12 (0x0C), not running, end stop in.
-    assert!(
-        lines.contains(&"0A0#05FF810000000000".to_string()),
-        "{lines:?}"
-    );
+    assert_sent_since(&b, mark, "0A0#05FF810000000000");
     assert_eq!(
         tpdos_since(&b, mark).last().map(String::as_str),
         Some("1A0#000000810C0000C0")
@@ -364,7 +362,7 @@ fn jammed_spindle_is_error_12_with_emcy_0xff05() {
     let mark = b.trace.len();
     rpdo(&mut b, [0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(20));
-    assert!(lines_since(&b, mark).contains(&"0A0#0000000000000000".to_string()));
+    assert_sent_since(&b, mark, "0A0#0000000000000000");
     rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(1500));
     assert_eq!(b.device.behaviour().position_mm(), 50.3);
