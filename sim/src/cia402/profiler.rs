@@ -105,12 +105,7 @@ impl Profiler {
         match goal {
             Goal::Stop { deceleration } => {
                 let v = self.velocity;
-                let dv = deceleration.max(f64::MIN_POSITIVE) * h;
-                let next = if v.abs() <= dv {
-                    0.0
-                } else {
-                    v - dv * v.signum()
-                };
+                let next = toward(v, 0.0, deceleration.max(f64::MIN_POSITIVE) * h);
                 self.position += (v + next) / 2.0 * h;
                 self.velocity = next;
             }
@@ -128,12 +123,7 @@ impl Profiler {
                 } else {
                     deceleration
                 };
-                let dv = rate.max(f64::MIN_POSITIVE) * h;
-                let next = if (velocity - v).abs() <= dv {
-                    velocity
-                } else {
-                    v + dv * (velocity - v).signum()
-                };
+                let next = toward(v, velocity, rate.max(f64::MIN_POSITIVE) * h);
                 self.position += (v + next) / 2.0 * h;
                 self.velocity = next;
             }
@@ -193,6 +183,18 @@ impl Profiler {
                 self.velocity = next * direction;
             }
         }
+    }
+}
+
+/// `v` moved towards `target` by at most `step` (a speed ramp; the seed
+/// models' mechanics use it too).
+pub(crate) fn toward(v: f64, target: f64, step: f64) -> f64 {
+    if (target - v).abs() <= step {
+        target
+    } else if target > v {
+        v + step
+    } else {
+        v - step
     }
 }
 

@@ -3,7 +3,7 @@
 //! 4-5, p. 30-31; 0x4000 sub 3-6, p. 40). Pure arithmetic in mechanical
 //! time, no bus.
 
-use crate::models::toward;
+use crate::cia402::profiler::toward;
 
 /// Position resolution of the feedback (0.1 mm/bit, p. 32); a target
 /// closer than half of it counts as reached.
