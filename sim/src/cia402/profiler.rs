@@ -103,12 +103,15 @@ impl Profiler {
 
     fn step(&mut self, h: f64, goal: Goal) {
         match goal {
-            Goal::Stop { deceleration } => {
-                let v = self.velocity;
-                let next = toward(v, 0.0, deceleration.max(f64::MIN_POSITIVE) * h);
-                self.position += (v + next) / 2.0 * h;
-                self.velocity = next;
-            }
+            // Braking is a ramp to velocity 0 (never speeding up).
+            Goal::Stop { deceleration } => self.step(
+                h,
+                Goal::Velocity {
+                    velocity: 0.0,
+                    acceleration: deceleration,
+                    deceleration,
+                },
+            ),
             Goal::Velocity {
                 velocity,
                 acceleration,
