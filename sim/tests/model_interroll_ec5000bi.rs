@@ -94,6 +94,15 @@ fn has(b: &Bench<Ec5000Bi>, line: &str) -> bool {
     lines(b).iter().any(|l| l == line)
 }
 
+/// A drive at node 127 in real time, enabled in profile velocity mode with
+/// target velocity `mm_s` (0x60FF).
+fn conveying(mm_s: i32) -> Bench<Ec5000Bi> {
+    let mut b = bench(1.0);
+    enable(&mut b, N127);
+    down(&mut b, N127, 0x60FF, 0, &mm_s.to_le_bytes());
+    b
+}
+
 /// When the frames with CAN id `id` (`1FF#`) were sent.
 fn sent_at(b: &Bench<Ec5000Bi>, id: &str) -> Vec<Instant> {
     b.trace
@@ -269,9 +278,7 @@ fn velocity_mode_ramps_runs_and_halts() {
 
 #[test]
 fn target_below_the_minimum_velocity_holds() {
-    let mut b = bench(1.0);
-    enable(&mut b, N127);
-    down(&mut b, N127, 0x60FF, 0, &10i32.to_le_bytes());
+    let mut b = conveying(10);
     b.run_for(Duration::from_millis(300));
     assert_eq!(i32_at(&mut b, N127, 0x606C), 0);
     // Above the maximum profile velocity (607Fh 2000): limited, bit 11.
@@ -282,9 +289,7 @@ fn target_below_the_minimum_velocity_holds() {
 
 #[test]
 fn mode_change_follows_the_matrix_of_chapter_4_1() {
-    let mut b = bench(1.0);
-    enable(&mut b, N127);
-    down(&mut b, N127, 0x60FF, 0, &300i32.to_le_bytes());
+    let mut b = conveying(300);
     b.run_for(Duration::from_millis(200));
     // Running (52): no change to position mode.
     let r = b.download(node(N127), 0x6060, 0, &[1]);

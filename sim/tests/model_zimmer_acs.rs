@@ -112,6 +112,16 @@ fn set_point(b: &mut Bench<ZimmerAcs>, target_um: i32, cw: u16) {
     controlword(b, cw);
 }
 
+/// An axis at time scale `scale`, enabled, 200 ms into a move to
+/// `target_um`.
+fn moving(scale: f64, target_um: i32) -> Bench<ZimmerAcs> {
+    let mut b = bench_with(ZimmerAcs::new().with_time_scale(scale));
+    enable(&mut b);
+    set_point(&mut b, target_um, 0x1F);
+    b.run_for(ms(200));
+    b
+}
+
 /// The STO inputs (true = 24 V).
 fn set_sto(b: &mut Bench<ZimmerAcs>, sto1: bool, sto2: bool) {
     let now = b.now();
@@ -426,10 +436,7 @@ fn store_and_restore_take_only_their_signatures() {
 
 #[test]
 fn the_position_survives_a_power_cycle_and_the_controlword_does_not() {
-    let mut b = bench_with(ZimmerAcs::new().with_time_scale(10.0));
-    enable(&mut b);
-    set_point(&mut b, 12_345, 0x1F);
-    b.run_for(ms(200));
+    let mut b = moving(10.0, 12_345);
     write(&mut b, 0x1010, 1, b"save");
     let now = b.now();
     b.device.power_cycle(now);
@@ -480,10 +487,7 @@ fn modes_and_option_codes_outside_the_manual_are_refused() {
 
 #[test]
 fn quick_stop_ramps_down_then_disables() {
-    let mut b = bench_with(ZimmerAcs::new().with_time_scale(2.0));
-    enable(&mut b);
-    set_point(&mut b, 90_000, 0x1F);
-    b.run_for(ms(200));
+    let mut b = moving(2.0, 90_000);
     let moving = position(&mut b);
     assert!(moving > 0 && moving < 90_000);
     model_events(&mut b);
