@@ -54,7 +54,7 @@ fn started(model: LinakTechline) -> B {
         .expect("0x1016");
     nmt(&mut b, NmtCommand::Start);
     b.run_for(ms(50));
-    rpdo(&mut b, [0x03, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB03);
     b.run_for(ms(50));
     b
 }
@@ -70,6 +70,20 @@ fn nmt(b: &mut B, cmd: NmtCommand) {
 /// RPDO1 of node 32 (0x220) from the master.
 fn rpdo(b: &mut B, data: [u8; 8]) {
     b.inject(&frame(0x220, &data));
+}
+
+/// RPDO1 with the position command `position` (0xFB00 clear error, 0xFB01
+/// run out, 0xFB02 run in, 0xFB03 stop, ...) and every other field at its
+/// default 0xFB.
+fn command(b: &mut B, position: u16) {
+    let [lo, hi] = position.to_le_bytes();
+    rpdo(b, [lo, hi, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+}
+
+/// Jams the spindle (`true`) or frees it.
+fn jam(b: &mut B, jammed: bool) {
+    let now = b.now();
+    b.device.with_model(now, |m, _| m.set_jammed(jammed));
 }
 
 /// The trace from `from` on, without the master's heartbeats.
@@ -131,7 +145,7 @@ fn start_up_follows_the_manuals_trace() {
         .expect("0x1016");
     nmt(&mut b, NmtCommand::Start);
     b.run_for(ms(20));
-    rpdo(&mut b, [0x03, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB03);
     b.run_for(ms(20));
     // Exactly the manual's frames, in its order: SDO write and answer, NMT
     // start, TPDO1 "stop required" (error 1), Stop, end stop in, no error.
@@ -157,7 +171,7 @@ fn start_up_follows_the_manuals_trace() {
 fn runs_out_to_the_end_stop_and_back() {
     let mut b = started(fast());
     let mark = b.trace.len();
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(1500));
     let out = tpdos_since(&b, mark);
     // Running out: current 0x06 (1.5 A), status 0x88, speed 0x0032 (5.0
@@ -166,7 +180,7 @@ fn runs_out_to_the_end_stop_and_back() {
     assert_eq!(out.last().map(String::as_str), Some("1A0#F7010082000000C0"));
     assert_eq!(b.device.behaviour().position_mm(), 50.3);
     let mark = b.trace.len();
-    rpdo(&mut b, [0x02, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB02);
     b.run_for(ms(1500));
     let back = tpdos_since(&b, mark);
     assert!(back.iter().any(|l| &l[8..16] == "06900032"), "{back:?}");
@@ -191,7 +205,7 @@ fn moving_feedback_comes_once_per_event_timer() {
     // Real time: 50.3 mm at 5 mm/s take about 10 s.
     let mut b = started(LinakTechline::new());
     let mark = b.trace.len();
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(2000));
     let times: Vec<u64> = b.trace[mark..]
         .iter()
@@ -215,9 +229,9 @@ fn runs_to_a_position_and_stops_on_an_invalid_value() {
     b.run_for(ms(1000));
     assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#C8000080000000C0"));
     // Run out, then 0xFB06 (invalid): the actuator ramps down and stays.
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(200));
-    rpdo(&mut b, [0x06, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB06);
     b.run_for(ms(500));
     let stopped = b.device.behaviour().position_mm();
     assert!(stopped > 20.0 && stopped < 50.0, "{stopped}");
@@ -264,7 +278,7 @@ fn power_up_lock_refuses_runs_until_stop() {
         .expect("0x1016");
     nmt(&mut b, NmtCommand::Start);
     model_events(&mut b);
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(300));
     assert_eq!(b.device.behaviour().position_mm(), 0.0);
     assert!(
@@ -274,7 +288,7 @@ fn power_up_lock_refuses_runs_until_stop() {
         })
     );
     // Clear error (0xFB00) releases it as well as Stop does.
-    rpdo(&mut b, [0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB00);
     b.run_for(ms(20));
     assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#00000081000000C0"));
     // Leaving and entering Operational arms the lock again (p. 27).
@@ -287,7 +301,7 @@ fn power_up_lock_refuses_runs_until_stop() {
 #[test]
 fn heartbeat_loss_stops_sets_error_5_and_sends_emcy_0x8130() {
     let mut b = started(LinakTechline::new());
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(500));
     assert_eq!(b.device.behaviour().running(), Some(Direction::Out));
     let now = b.now();
@@ -316,11 +330,11 @@ fn heartbeat_loss_stops_sets_error_5_and_sends_emcy_0x8130() {
     b.run_for(ms(150));
     assert_eq!(read(&mut b, 0x2001, 3), [0x80]);
     assert_eq!(read(&mut b, 0x2001, 4), [0x05]);
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(100));
     assert_eq!(b.device.behaviour().running(), None);
     let mark = b.trace.len();
-    rpdo(&mut b, [0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB00);
     b.run_for(ms(20));
     assert_sent_since(&b, mark, "0A0#0000000000000000");
     assert_eq!(read(&mut b, 0x2001, 4), [0x00]);
@@ -334,10 +348,9 @@ fn heartbeat_loss_stops_sets_error_5_and_sends_emcy_0x8130() {
 #[test]
 fn jammed_spindle_is_error_12_with_emcy_0xff05() {
     let mut b = started(fast());
-    let now = b.now();
-    b.device.with_model(now, |m, _| m.set_jammed(true));
+    jam(&mut b, true);
     let mark = b.trace.len();
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(200));
     // Code 0xFF05 "position does not change", register 0x81 (generic +
     // manufacturer); feedback error 12 (0x0C), not running, end stop in.
@@ -348,7 +361,7 @@ fn jammed_spindle_is_error_12_with_emcy_0xff05() {
     );
     assert_eq!(read(&mut b, 0x4000, 0x26), [0x00, 0x02]); // reason 512
     // Run out is refused while the error is there.
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(100));
     assert!(
         model_events(&mut b).contains(&LinakTechlineEvent::CommandRefused {
@@ -357,13 +370,12 @@ fn jammed_spindle_is_error_12_with_emcy_0xff05() {
         })
     );
     // Freed and cleared (p. 29): EMCY error reset, error 0, moves again.
-    let now = b.now();
-    b.device.with_model(now, |m, _| m.set_jammed(false));
+    jam(&mut b, false);
     let mark = b.trace.len();
-    rpdo(&mut b, [0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB00);
     b.run_for(ms(20));
     assert_sent_since(&b, mark, "0A0#0000000000000000");
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(1500));
     assert_eq!(b.device.behaviour().position_mm(), 50.3);
 }
@@ -374,7 +386,7 @@ fn obstacle_trips_the_current_limit() {
     let now = b.now();
     b.device
         .with_model(now, |m, _| m.set_obstacle_out(Some(20.0)));
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(1000));
     // Stopped at 20.0 mm (0x00C8), status 0x84 (overcurrent), error 0.
     assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#C8000084000000C0"));
@@ -382,7 +394,7 @@ fn obstacle_trips_the_current_limit() {
     assert_eq!(read(&mut b, 0x4000, 0x26), [0x08, 0x00]); // reason 8
     assert_eq!(read(&mut b, 0x4000, 0x10), [16]); // 4.0 A peak
     // Run in is allowed (no error code) and clears the flag.
-    rpdo(&mut b, [0x02, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB02);
     b.run_for(ms(1000));
     assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#00000081000000C0"));
     // A user limit of 1.0 A (0x04) is below the running current: cut off at
@@ -433,16 +445,14 @@ fn identity_and_lss_address() {
 #[test]
 fn recovery_run_moves_despite_error_12() {
     let mut b = started(fast());
-    let now = b.now();
-    b.device.with_model(now, |m, _| m.set_jammed(true));
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    jam(&mut b, true);
+    command(&mut b, 0xFB01);
     b.run_for(ms(200));
     assert_eq!(read(&mut b, 0x2001, 4), [0x0C]);
-    let now = b.now();
-    b.device.with_model(now, |m, _| m.set_jammed(false));
+    jam(&mut b, false);
     // Recovery run out (0xFB04) is taken with error 12 present; the error
     // stays until Clear error.
-    rpdo(&mut b, [0x04, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB04);
     b.run_for(ms(1500));
     assert_eq!(b.device.behaviour().position_mm(), 50.3);
     assert_eq!(read(&mut b, 0x2001, 4), [0x0C]);
