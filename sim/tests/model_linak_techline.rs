@@ -45,18 +45,23 @@ fn fast() -> LinakTechline {
     LinakTechline::new().with_time_scale(10.0)
 }
 
-/// The manual's start-up up to the Stop command: 0x1016 sub 1 = 0x000100C8,
-/// NMT start, Stop (p. 28).
+/// A booted actuator after the manual's start-up ([`start_up`]).
 fn started(model: LinakTechline) -> B {
     let mut b = bench_with(model);
     b.run_for(ms(150));
+    start_up(&mut b, ms(50));
+    b
+}
+
+/// The manual's start-up up to the Stop command: 0x1016 sub 1 = 0x000100C8,
+/// NMT start, Stop (p. 28), with `pause` after NMT start and after Stop.
+fn start_up(b: &mut B, pause: Duration) {
     b.download(NODE, 0x1016, 1, &[0xC8, 0x00, 0x01, 0x00])
         .expect("0x1016");
-    nmt(&mut b, NmtCommand::Start);
-    b.run_for(ms(50));
-    command(&mut b, 0xFB03);
-    b.run_for(ms(50));
-    b
+    nmt(b, NmtCommand::Start);
+    b.run_for(pause);
+    command(b, 0xFB03);
+    b.run_for(pause);
 }
 
 fn nmt(b: &mut B, cmd: NmtCommand) {
@@ -141,12 +146,7 @@ fn start_up_follows_the_manuals_trace() {
     assert_eq!(b.trace_lines(), ["701#00", "720#00", "701#05"]);
     assert_eq!(b.trace[2].0, Instant::from_millis(100));
     let mark = b.trace.len();
-    b.download(NODE, 0x1016, 1, &[0xC8, 0x00, 0x01, 0x00])
-        .expect("0x1016");
-    nmt(&mut b, NmtCommand::Start);
-    b.run_for(ms(20));
-    command(&mut b, 0xFB03);
-    b.run_for(ms(20));
+    start_up(&mut b, ms(20));
     // Exactly the manual's frames, in its order: SDO write and answer, NMT
     // start, TPDO1 "stop required" (error 1), Stop, end stop in, no error.
     // No TPDO2 (the trace shows none).
