@@ -64,56 +64,32 @@ fn sdo_writes_are_checked_for_access_type_and_limits() {
     let mut b = example_bench();
     let n = node(5);
     // Access rights: write-only, read-only, missing index and subindex.
-    assert_eq!(
-        b.upload(n, 0x2001, 0).map(drop),
-        abort(AbortCode::ReadWriteOnly)
-    );
-    assert_eq!(
-        b.download(n, 0x6041, 0, &[0, 0]),
-        abort(AbortCode::WriteReadOnly)
-    );
-    assert_eq!(
-        b.download(n, 0x1018, 1, &[0; 4]),
-        abort(AbortCode::WriteReadOnly)
-    );
-    assert_eq!(
-        b.upload(n, 0x3000, 0).map(drop),
-        abort(AbortCode::ObjectDoesNotExist)
-    );
-    assert_eq!(
-        b.upload(n, 0x1018, 9).map(drop),
-        abort(AbortCode::SubindexDoesNotExist)
-    );
-    // Type: 0x6060 is INTEGER8.
-    assert_eq!(
-        b.download(n, 0x6060, 0, &[1, 0]),
-        abort(AbortCode::LengthTooHigh)
-    );
-    assert_eq!(
-        b.download(n, 0x1017, 0, &[1]),
-        abort(AbortCode::LengthTooLow)
-    );
-    // Limits: 0x6060 is -4..=10, 0x2000 (REAL32) 1.0..=100.0.
-    assert_eq!(
-        b.download(n, 0x6060, 0, &[11]),
-        abort(AbortCode::ValueTooHigh)
-    );
-    assert_eq!(
-        b.download(n, 0x6060, 0, &[(-5i8) as u8]),
-        abort(AbortCode::ValueTooLow)
-    );
+    for (index, sub, code) in [
+        (0x2001, 0, AbortCode::ReadWriteOnly),
+        (0x3000, 0, AbortCode::ObjectDoesNotExist),
+        (0x1018, 9, AbortCode::SubindexDoesNotExist),
+    ] {
+        let read = b.upload(n, index, sub).map(drop);
+        assert_eq!(read, abort(code), "read {index:#06X}/{sub}");
+    }
+    let (half, big) = (0.5f32.to_le_bytes(), 100.5f32.to_le_bytes());
+    for (index, sub, data, code) in [
+        (0x6041, 0, &[0, 0][..], AbortCode::WriteReadOnly),
+        (0x1018, 1, &[0; 4], AbortCode::WriteReadOnly),
+        // Type: 0x6060 is INTEGER8.
+        (0x6060, 0, &[1, 0], AbortCode::LengthTooHigh),
+        (0x1017, 0, &[1], AbortCode::LengthTooLow),
+        // Limits: 0x6060 is -4..=10, 0x2000 (REAL32) 1.0..=100.0.
+        (0x6060, 0, &[11], AbortCode::ValueTooHigh),
+        (0x6060, 0, &[(-5i8) as u8], AbortCode::ValueTooLow),
+        (0x2000, 0, &half, AbortCode::ValueTooLow),
+        (0x2000, 0, &big, AbortCode::ValueTooHigh),
+    ] {
+        let write = b.download(n, index, sub, data);
+        assert_eq!(write, abort(code), "write {data:?} to {index:#06X}/{sub}");
+    }
     b.download(n, 0x6060, 0, &[(-4i8) as u8])
         .expect("-4 is the low limit");
-    let half = 0.5f32.to_le_bytes();
-    assert_eq!(
-        b.download(n, 0x2000, 0, &half),
-        abort(AbortCode::ValueTooLow)
-    );
-    let big = 100.5f32.to_le_bytes();
-    assert_eq!(
-        b.download(n, 0x2000, 0, &big),
-        abort(AbortCode::ValueTooHigh)
-    );
     b.download(n, 0x2000, 0, &50.0f32.to_le_bytes())
         .expect("50.0");
     assert_eq!(b.upload(n, 0x2000, 0).expect("read"), 50.0f32.to_le_bytes());
