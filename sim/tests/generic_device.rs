@@ -40,6 +40,14 @@ fn abort(code: AbortCode) -> Result<(), SdoError> {
     Err(SdoError::RemoteAbort(code))
 }
 
+/// The master sends NMT `command` to `target` (at its next step).
+fn nmt<B: eds2rust_sim::Behaviour>(b: &mut Bench<B>, command: NmtCommand, target: NodeId) {
+    b.master
+        .nmt
+        .send(command, NmtTarget::Node(target))
+        .expect("queue");
+}
+
 #[test]
 fn boots_and_produces_the_heartbeat_of_0x1017() {
     let mut b = example_bench();
@@ -146,10 +154,7 @@ fn pdo_mapping_follows_the_cia_301_order_and_rules() {
         .expect("enable");
     // Operational: the new layout goes out at once, then on the 100 ms
     // event timer: position (0), statusword (0).
-    b.master
-        .nmt
-        .send(NmtCommand::Start, NmtTarget::Node(n))
-        .expect("queue");
+    nmt(&mut b, NmtCommand::Start, n);
     b.run_for(Duration::from_millis(150));
     let tpdos: Vec<String> = b
         .trace_lines()
@@ -162,10 +167,7 @@ fn pdo_mapping_follows_the_cia_301_order_and_rules() {
 #[test]
 fn rpdos_write_the_mapped_entries_and_length_errors_raise_emcy() {
     let mut b = example_bench();
-    b.master
-        .nmt
-        .send(NmtCommand::Start, NmtTarget::Node(node(5)))
-        .expect("queue");
+    nmt(&mut b, NmtCommand::Start, node(5));
     b.run_for(Duration::from_millis(1));
     // RPDO1: controlword 0x000F, target position 1000.
     b.inject(&frame(0x205, &[0x0F, 0x00, 0xE8, 0x03, 0x00, 0x00]));
@@ -198,10 +200,7 @@ fn rpdos_write_the_mapped_entries_and_length_errors_raise_emcy() {
         Some("085#2082000000000000")
     );
     // Pre-operational: RPDOs are ignored.
-    b.master
-        .nmt
-        .send(NmtCommand::EnterPreOperational, NmtTarget::Node(node(5)))
-        .expect("queue");
+    nmt(&mut b, NmtCommand::EnterPreOperational, node(5));
     b.run_for(Duration::from_millis(1));
     b.inject(&frame(0x205, &[0x07, 0x00, 0, 0, 0, 0]));
     assert_eq!(b.device.table().get(0x6040, 0), Some(&[0x06, 0x00][..]));
