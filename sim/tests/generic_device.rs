@@ -40,6 +40,12 @@ fn abort(code: AbortCode) -> Result<(), SdoError> {
     Err(SdoError::RemoteAbort(code))
 }
 
+/// The master's LSS switch state global to `state`.
+fn switch_global<B: eds2rust_sim::Behaviour>(b: &mut Bench<B>, state: LssState) {
+    let now = b.now();
+    b.master.lss.switch_global(now, state).expect("idle");
+}
+
 /// The master sends NMT `command` to `target` (at its next step).
 fn nmt<B: eds2rust_sim::Behaviour>(b: &mut Bench<B>, command: NmtCommand, target: NodeId) {
     b.master
@@ -259,11 +265,7 @@ fn an_unconfigured_lss_slave_gets_its_node_id_and_moves_its_sdo_server() {
     // Unconfigured: no boot-up, no heartbeat (701#00 is the master's).
     assert_eq!(b.trace_lines(), ["701#00"]);
     b.trace.clear();
-    let now = b.now();
-    b.master
-        .lss
-        .switch_global(now, LssState::Configuration)
-        .expect("idle");
+    switch_global(&mut b, LssState::Configuration);
     b.run_for(Duration::from_millis(1));
     let now = b.now();
     b.master.lss.configure_node_id(now, node(9)).expect("idle");
@@ -271,11 +273,7 @@ fn an_unconfigured_lss_slave_gets_its_node_id_and_moves_its_sdo_server() {
         e,
         MasterEvent::Lss(_)
     )));
-    let now = b.now();
-    b.master
-        .lss
-        .switch_global(now, LssState::Waiting)
-        .expect("idle");
+    switch_global(&mut b, LssState::Waiting);
     // CiA 305: an unconfigured slave that got a node id resets its
     // communication by itself when switched back to waiting.
     b.run_for(Duration::from_millis(1));
