@@ -17,8 +17,8 @@ use eds2rust_runtime::{CanId, Frame, Instant};
 use eds2rust_sim::SimEvent;
 use eds2rust_sim::bench::Bench;
 use eds2rust_sim::models::linak_techline::{
-    Direction, LinakTechline, LinakTechlineEvent, NODE, Refusal, StopReason, default_config,
-    simulator_with,
+    Direction, LinakTechline, LinakTechlineEvent, MANUAL_TRACE, NODE, Refusal, StopReason,
+    default_config, simulator_with,
 };
 
 type B = Bench<LinakTechline>;
@@ -150,17 +150,7 @@ fn start_up_follows_the_manuals_trace() {
     // Exactly the manual's frames, in its order: SDO write and answer, NMT
     // start, TPDO1 "stop required" (error 1), Stop, end stop in, no error.
     // No TPDO2 (the trace shows none).
-    assert_eq!(
-        lines_since(&b, mark),
-        [
-            "620#23161001C8000100",
-            "5A0#6016100100000000",
-            "000#0120",
-            "1A0#00000081010000C0",
-            "220#03FBFBFBFBFB0000",
-            "1A0#00000081000000C0",
-        ]
-    );
+    assert_eq!(lines_since(&b, mark), MANUAL_TRACE[2..8]);
     // Standing still, TPDO1 repeats on its event timer (0x1800 sub 5, 250 ms).
     let mark = b.trace.len();
     b.run_for(ms(1000));

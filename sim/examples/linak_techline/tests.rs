@@ -5,23 +5,7 @@ use serde_json::Value as Json;
 use super::common::decoded::*;
 use super::common::run_at;
 use super::*;
-
-/// The manual's trace (p. 28), every frame that does not depend on the
-/// motion, in its order.
-const MANUAL: [&str; 12] = [
-    "701#05",
-    "720#00",
-    "620#23161001C8000100",
-    "5A0#6016100100000000",
-    "000#0120",
-    "1A0#00000081010000C0",
-    "220#03FBFBFBFBFB0000",
-    "1A0#00000081000000C0",
-    "220#01FBFBFBFBFB0000",
-    "1A0#F7010082000000C0",
-    "220#02FBFBFBFBFB0000",
-    "1A0#00000081000000C0",
-];
+use eds2rust_sim::models::linak_techline::MANUAL_TRACE;
 
 /// Positions in `trace` where the lines of `wanted` appear in order.
 fn subsequence(trace: &[String], wanted: &[&str]) -> Option<Vec<usize>> {
@@ -43,7 +27,7 @@ fn the_manuals_start_up_then_out_and_back() {
     assert_eq!(summary.status, 0x81);
     assert_eq!(summary.error_code, 0);
     let trace = &summary.trace;
-    let at = subsequence(trace, &MANUAL)
+    let at = subsequence(trace, &MANUAL_TRACE)
         .unwrap_or_else(|| panic!("manual frames not in order:\n{}", trace.join("\n")));
     // The first frame of the actuator after NMT start is the "stop
     // required" TPDO1 (no TPDO2, no EMCY).
