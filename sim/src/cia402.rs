@@ -55,6 +55,7 @@
 //! shown in 0x6061, the axis holds its position).
 
 pub(crate) mod axis;
+mod drive;
 mod logic;
 mod monitor;
 mod objects;

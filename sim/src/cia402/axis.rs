@@ -13,6 +13,7 @@ use eds2rust_runtime::cia402::{
 };
 
 use super::profiler::{Goal, Profiler};
+use crate::Context;
 
 /// The state machine, the mechanics and the set-points of one axis.
 #[derive(Debug, Clone)]
@@ -251,5 +252,67 @@ impl Axis {
                 || (self.profiler.position == self.goal
                     && self.queued.is_none()
                     && (self.goal - self.actual).abs() <= window))
+    }
+}
+
+/// A simulated drive on the [`Axis`]: when each step of CiA 402 happens is
+/// the axis's rule, what it does is the model's.
+pub(crate) trait Drive {
+    /// The model's events.
+    type Event;
+
+    /// The axis.
+    fn axis(&mut self) -> &mut Axis;
+
+    /// Operation enabled: the mode of operation moves the axis for
+    /// `seconds` of model time.
+    fn run_enabled(&mut self, ctx: &mut Context<'_, Self::Event>, seconds: f64);
+
+    /// Quick stop active: the braking deceleration of the option code, and
+    /// whether the drive stays in Quick stop active at rest.
+    fn quick_stop(&mut self, ctx: &mut Context<'_, Self::Event>) -> (f64, bool);
+
+    /// Any other state: the motion stops.
+    fn stop_motion(&mut self);
+
+    /// A new set-point (controlword bits 4-6), taken in Operation enabled.
+    fn start_set_point(
+        &mut self,
+        ctx: &mut Context<'_, Self::Event>,
+        immediate: bool,
+        relative: bool,
+    );
+
+    /// The following error monitor (statusword bit 13).
+    fn check_following_error(&mut self, ctx: &mut Context<'_, Self::Event>);
+
+    /// Target reached (statusword bit 10).
+    fn update_target_reached(&mut self, ctx: &mut Context<'_, Self::Event>);
+
+    /// Runs the mechanics from the last input to `ctx.now()` as the state
+    /// says; the model time that passed (s).
+    fn run_mechanics(&mut self, ctx: &mut Context<'_, Self::Event>) -> f64 {
+        let now = ctx.now();
+        let seconds = self.axis().elapsed(now);
+        match self.axis().state() {
+            Some(State::OperationEnabled) => self.run_enabled(ctx, seconds),
+            Some(State::QuickStopActive) => {
+                let (deceleration, stays) = self.quick_stop(ctx);
+                self.axis()
+                    .brake_quick_stop(now, seconds, deceleration, stays);
+            }
+            _ => self.stop_motion(),
+        }
+        seconds
+    }
+
+    /// The periodic part: the set-point deferred to this step, the
+    /// following error, target reached.
+    fn monitor_motion(&mut self, ctx: &mut Context<'_, Self::Event>) {
+        if let Some((immediate, relative)) = self.axis().deferred_set_point() {
+            self.start_set_point(ctx, immediate, relative);
+        }
+        self.check_following_error(ctx);
+        self.update_target_reached(ctx);
     }
 }

@@ -9,7 +9,7 @@ use eds2rust_runtime::cia402::{
     State,
 };
 
-use super::axis::Step;
+use super::axis::{Drive, Step};
 use super::objects::{self as obj, int};
 use super::profiler::{Goal, Profiler};
 use super::{Cia402, Cia402Event};
@@ -114,11 +114,6 @@ impl Cia402 {
         self.axis.sm = Some(sm);
     }
 
-    fn stop_motion(&mut self) {
-        self.homing_in_place = None;
-        self.axis.stop_motion();
-    }
-
     /// Raises a fault with `code`: 0x603F, 0x1001 bit 0, EMCY, Fault.
     pub(super) fn fault(&mut self, ctx: Ctx<'_, '_>, code: u16) {
         if !self.axis.raise_fault(ctx.now(), code) {
@@ -217,23 +212,7 @@ impl Cia402 {
 
     /// Runs the mechanics from the last input to `ctx.now()`.
     fn advance(&mut self, ctx: Ctx<'_, '_>) {
-        let now = ctx.now();
-        let seconds = self.axis.elapsed(now);
-        match self.state() {
-            Some(State::OperationEnabled) => self.run_enabled(ctx, seconds),
-            Some(State::QuickStopActive) => {
-                let (code, stays) = self.axis.sm.as_ref().map_or((2, false), |sm| {
-                    (
-                        sm.config().quick_stop_option_code,
-                        sm.config().stays_in_quick_stop(),
-                    )
-                });
-                let deceleration = obj::braking(ctx.table(), i64::from(code));
-                self.axis
-                    .brake_quick_stop(now, seconds, deceleration, stays);
-            }
-            _ => self.stop_motion(),
-        }
+        let seconds = self.run_mechanics(ctx);
         self.follow(seconds);
     }
 
@@ -271,103 +250,16 @@ impl Cia402 {
     }
 
     /// The braking goal of a halt (0x605D; 1, slow down ramp, without it).
-    fn halt_goal(&self, ctx: Ctx<'_, '_>) -> Goal {
+    pub(super) fn halt_goal(&self, ctx: Ctx<'_, '_>) -> Goal {
         let code = int(ctx.table(), obj::HALT_OPTION_CODE).unwrap_or(1);
         Goal::Stop {
             deceleration: obj::braking(ctx.table(), code),
         }
     }
 
-    fn run_enabled(&mut self, ctx: Ctx<'_, '_>, seconds: f64) {
-        let halt = self.halted();
-        match self.mode() {
-            ModeOfOperation::CyclicSynchronousPosition => {
-                // The axis takes each target at once; no interpolation.
-                let raw = int(ctx.table(), obj::TARGET_POSITION).unwrap_or(0) as f64;
-                let target = self.limit(ctx, raw);
-                self.axis.profiler = Profiler::at(target);
-                self.axis.goal = target;
-            }
-            ModeOfOperation::ProfilePosition => {
-                let goal = if halt {
-                    self.halt_goal(ctx)
-                } else {
-                    let p = obj::profile(ctx.table());
-                    Goal::Target {
-                        target: self.axis.goal,
-                        velocity: p.velocity,
-                        acceleration: p.acceleration,
-                        deceleration: p.deceleration,
-                    }
-                };
-                if self.axis.profiler.run(seconds, goal)
-                    && !halt
-                    && let Some(next) = self.axis.queued.take()
-                {
-                    self.axis.start_motion(next);
-                }
-            }
-            ModeOfOperation::ProfileVelocity => {
-                let goal = if halt {
-                    self.halt_goal(ctx)
-                } else {
-                    let p = obj::profile(ctx.table());
-                    let target = int(ctx.table(), obj::TARGET_VELOCITY).unwrap_or(0) as f64;
-                    Goal::Velocity {
-                        velocity: obj::limit_velocity(ctx.table(), target),
-                        acceleration: p.acceleration,
-                        deceleration: p.deceleration,
-                    }
-                };
-                self.axis.profiler.run(seconds, goal);
-                // At a software limit the axis stops (bit 11).
-                let position = self.axis.profiler.position;
-                let limited = self.limit(ctx, position);
-                if limited != position {
-                    self.axis.profiler = Profiler::at(limited);
-                }
-                self.axis.goal = self.axis.profiler.position;
-            }
-            ModeOfOperation::Homing => {
-                let homing = self
-                    .axis
-                    .sm
-                    .as_ref()
-                    .is_some_and(DeviceStateMachine::homing_active);
-                let goal = if halt || !homing || self.homing_in_place.is_some() {
-                    self.halt_goal(ctx)
-                } else {
-                    let p = obj::homing_profile(ctx.table());
-                    Goal::Target {
-                        target: self.home_switch,
-                        velocity: p.velocity,
-                        acceleration: p.acceleration,
-                        deceleration: p.deceleration,
-                    }
-                };
-                if let Some(at) = self.homing_in_place {
-                    if homing && ctx.now() >= at {
-                        self.homing_in_place = None;
-                        self.home_here(ctx);
-                    }
-                } else if self.axis.profiler.run(seconds, goal) && homing && !halt {
-                    self.home_here(ctx);
-                }
-            }
-            _ => {
-                self.axis.profiler.run(
-                    seconds,
-                    Goal::Stop {
-                        deceleration: obj::profile(ctx.table()).deceleration,
-                    },
-                );
-            }
-        }
-    }
-
     /// `position` within the software limits; sets bit 11 when clamped
     /// (and clears it when not).
-    fn limit(&mut self, ctx: Ctx<'_, '_>, position: f64) -> f64 {
+    pub(super) fn limit(&mut self, ctx: Ctx<'_, '_>, position: f64) -> f64 {
         let limited = match obj::position_limits(ctx.table()) {
             Some((min, max)) => position.clamp(min, max),
             None => position,
@@ -376,39 +268,6 @@ impl Cia402 {
             sm.set_internal_limit(limited != position);
         }
         limited
-    }
-
-    /// A new set-point (bits 4-6): the target, its limits, then now (bit 5
-    /// or at rest) or after the running move.
-    pub(super) fn start_set_point(&mut self, ctx: Ctx<'_, '_>, immediate: bool, relative: bool) {
-        let raw = int(ctx.table(), obj::TARGET_POSITION).unwrap_or(0) as f64;
-        let requested = if relative {
-            // 0x60F2 bits 0-1: 0 preceding target, 1 demand, 2 actual.
-            let option = int(ctx.table(), obj::POSITIONING_OPTION_CODE).unwrap_or(0) & 3;
-            let reference = match option {
-                1 => self.axis.profiler.position,
-                2 => self.axis.actual,
-                _ => self.axis.queued.unwrap_or(self.axis.goal),
-            };
-            reference + raw
-        } else {
-            raw
-        };
-        let target = self.limit(ctx, requested);
-        if target != requested {
-            ctx.emit(Cia402Event::TargetLimited {
-                requested: requested.round() as i64,
-                limited: target.round() as i64,
-            });
-        }
-        ctx.emit(Cia402Event::SetPointAccepted {
-            target: target.round() as i64,
-            relative,
-            immediate,
-        });
-        if self.axis.take_set_point(target, immediate) {
-            self.axis.start_motion(target);
-        }
     }
 
     /// Homing started (bit 4 rising in homing mode).
@@ -424,7 +283,7 @@ impl Cia402 {
 
     /// The axis is at the home switch: the position becomes the home
     /// offset; homing attained.
-    fn home_here(&mut self, ctx: Ctx<'_, '_>) {
+    pub(super) fn home_here(&mut self, ctx: Ctx<'_, '_>) {
         let offset = int(ctx.table(), obj::HOME_OFFSET).unwrap_or(0) as f64;
         self.axis.actual = offset;
         self.axis.profiler = Profiler::at(offset);

@@ -35,7 +35,7 @@ use eds2rust_runtime::cia402::{
 use super::factory::{self, RAMP_MAX};
 use super::{POSITION_WINDOW_TIME, STO_LATCH_TIME, ZimmerAcs, ZimmerAcsEvent};
 use crate::Context;
-use crate::cia402::axis::Step;
+use crate::cia402::axis::{Axis, Drive, Step};
 use crate::cia402::profiler::{Goal, Profiler};
 
 type Ctx<'a, 'b> = &'a mut Context<'b, ZimmerAcsEvent>;
@@ -146,10 +146,6 @@ impl ZimmerAcs {
 
     fn mode(&self) -> ModeOfOperation {
         self.axis.mode()
-    }
-
-    fn stop_motion(&mut self) {
-        self.axis.stop_motion();
     }
 
     /// Raises `error` (15.4): 0x603F, Fault, EMCY with the error ID.
@@ -296,71 +292,12 @@ impl ZimmerAcs {
         f64::from(mm.max(1)) * UM_PER_MM
     }
 
-    /// Runs the mechanics from the last input to `ctx.now()`.
+    /// Runs the mechanics from the last input to `ctx.now()`; the carriage
+    /// follows the demand only when it can move (power stage, clamp).
     fn advance(&mut self, ctx: Ctx<'_, '_>) {
-        let now = ctx.now();
-        let seconds = self.axis.elapsed(now);
-        match self.state() {
-            Some(State::OperationEnabled) => self.run_enabled(ctx, seconds),
-            Some(State::QuickStopActive) => {
-                let code = ctx.get::<od::QuickStopOptionCode>().map_or(2, |v| v.0);
-                let quick = matches!(code, 2 | 6);
-                let deceleration = self.ramp(ctx, quick);
-                // 15.5: options 0..2 disable the drive after the ramp (12),
-                // 5 and 6 stay in Quick stop active.
-                let stays = !matches!(code, 0..=2);
-                self.axis
-                    .brake_quick_stop(now, seconds, deceleration, stays);
-            }
-            _ => self.stop_motion(),
-        }
+        self.run_mechanics(ctx);
         if self.movable() {
             self.axis.actual = self.axis.profiler.position;
-        }
-    }
-
-    fn run_enabled(&mut self, ctx: Ctx<'_, '_>, seconds: f64) {
-        let mode = self.mode();
-        if mode == ModeOfOperation::CyclicSynchronousPosition {
-            // The axis takes each target at once; no interpolation between
-            // set-points is modelled.
-            let raw = ctx.get::<od::TargetPosition>().map_or(0, |v| v.0);
-            let (min, max) = self.position_limits(ctx);
-            let target = f64::from(raw).max(min).min(max);
-            if let Some(sm) = self.axis.sm.as_mut() {
-                sm.set_internal_limit(target != f64::from(raw));
-            }
-            self.axis.profiler = Profiler::at(target);
-            self.axis.goal = target;
-            return;
-        }
-        if mode != ModeOfOperation::ProfilePosition {
-            return;
-        }
-        let halt = self.axis.halted();
-        let goal = if halt {
-            let code = ctx.get::<od::HaltOptionCode>().map_or(1, |v| v.0);
-            Goal::Stop {
-                deceleration: self.ramp(ctx, code == 2),
-            }
-        } else {
-            match self.profile(ctx) {
-                Some((velocity, acceleration, deceleration)) => Goal::Target {
-                    target: self.axis.goal,
-                    velocity,
-                    acceleration,
-                    deceleration,
-                },
-                None => Goal::Stop {
-                    deceleration: self.ramp(ctx, true),
-                },
-            }
-        };
-        if self.axis.profiler.run(seconds, goal)
-            && !halt
-            && let Some(next) = self.axis.queued.take()
-        {
-            self.start_motion(ctx, next);
         }
     }
 
@@ -370,39 +307,6 @@ impl ZimmerAcs {
             to_um: target.round() as i32,
         });
         self.axis.start_motion(target);
-    }
-
-    /// A new set-point (15.1.1 bits 4-6): the target, its limits, the
-    /// profile, then now (bit 5 or at rest) or after the running move.
-    fn start_set_point(&mut self, ctx: Ctx<'_, '_>, immediate: bool, relative: bool) {
-        let raw = f64::from(ctx.get::<od::TargetPosition>().map_or(0, |v| v.0));
-        let reference = self.axis.queued.unwrap_or(self.axis.goal);
-        let requested = if relative { reference + raw } else { raw };
-        let (min, max) = self.position_limits(ctx);
-        let target = requested.max(min).min(max);
-        let limited = target != requested;
-        if let Some(sm) = self.axis.sm.as_mut() {
-            sm.set_internal_limit(limited);
-        }
-        if limited {
-            ctx.emit(ZimmerAcsEvent::TargetLimited {
-                requested_um: requested.round() as i64,
-                limited_um: target.round() as i32,
-            });
-        }
-        if self.profile(ctx).is_none() {
-            self.fault(ctx, ZimmerErrors::ProfilerParametersNotValid);
-            return;
-        }
-        ctx.emit(ZimmerAcsEvent::SetPointAccepted {
-            target_um: target.round() as i32,
-            relative,
-            immediate,
-        });
-        if self.axis.take_set_point(target, immediate) {
-            self.start_motion(ctx, target);
-        }
-        self.axis.inside_since = None;
     }
 
     /// The periodic part: STO latch, deferred set-point, following error,
@@ -417,65 +321,7 @@ impl ZimmerAcs {
             ctx.emit(ZimmerAcsEvent::StoLatched);
             self.fault(ctx, ZimmerErrors::StoAbnormalFault);
         }
-        if let Some((immediate, relative)) = self.axis.deferred_set_point() {
-            self.start_set_point(ctx, immediate, relative);
-        }
-        self.check_following_error(ctx);
-        self.update_target_reached(ctx);
-    }
-
-    /// 15.5 0x6065/0x6066: outside the window for longer than the timeout
-    /// is a following error (bit 13, error 0x7387). 0xFFFFFFFF switches
-    /// the monitor off (CiA 402).
-    fn check_following_error(&mut self, ctx: Ctx<'_, '_>) {
-        let now = ctx.now();
-        if self.state() != Some(State::OperationEnabled) || !is_position_mode(self.mode()) {
-            self.axis.outside_since = None;
-            return;
-        }
-        let window = ctx
-            .get::<od::FollowingErrorWindow>()
-            .map_or(u32::MAX, |v| v.0);
-        let error = (self.axis.profiler.position - self.axis.actual).abs();
-        if window == u32::MAX || error <= f64::from(window) {
-            self.axis.outside_since = None;
-            return;
-        }
-        let since = *self.axis.outside_since.get_or_insert(now);
-        let timeout = ctx.get::<od::FollowingErrorTimeOut>().map_or(0, |v| v.0);
-        if now.saturating_duration_since(since) > Duration::from_millis(u64::from(timeout)) {
-            if let Some(sm) = self.axis.sm.as_mut() {
-                sm.set_position_following_error(true);
-            }
-            self.fault(ctx, ZimmerErrors::PositionFollowingError);
-        }
-    }
-
-    /// 15.1.2.1: target reached once the position stays within 0x21F1 of
-    /// the target for the window time; while halted it means standstill
-    /// (CiA 402).
-    fn update_target_reached(&mut self, ctx: Ctx<'_, '_>) {
-        let now = ctx.now();
-        let pp = self.state() == Some(State::OperationEnabled)
-            && self.mode() == ModeOfOperation::ProfilePosition;
-        let halt = self.axis.halted();
-        let window = f64::from(ctx.get::<od::PositionWindowX21F1>().map_or(0, |v| v.0));
-        let reached = if pp && self.axis.settled(halt, window) {
-            let since = *self.axis.inside_since.get_or_insert(now);
-            now.saturating_duration_since(since) >= POSITION_WINDOW_TIME
-        } else {
-            self.axis.inside_since = None;
-            false
-        };
-        if let Some(sm) = self.axis.sm.as_mut() {
-            sm.set_target_reached(reached);
-        }
-        if reached && self.axis.moving && !halt {
-            self.axis.moving = false;
-            ctx.emit(ZimmerAcsEvent::TargetReached {
-                position_um: self.axis.actual.round() as i32,
-            });
-        }
+        self.monitor_motion(ctx);
     }
 
     /// 11.6: the clamping element follows the state machine unless 0x2129
@@ -538,5 +384,159 @@ impl ZimmerAcs {
                 .with_sto_abnormal_fault(sto1 != sto2 || self.sto_latched)
                 .with_sto_report(report),
         );
+    }
+}
+
+impl Drive for ZimmerAcs {
+    type Event = ZimmerAcsEvent;
+
+    fn axis(&mut self) -> &mut Axis {
+        &mut self.axis
+    }
+
+    fn quick_stop(&mut self, ctx: Ctx<'_, '_>) -> (f64, bool) {
+        let code = ctx.get::<od::QuickStopOptionCode>().map_or(2, |v| v.0);
+        // 15.5: options 0..2 disable the drive after the ramp (12), 5 and
+        // 6 stay in Quick stop active; 2 and 6 brake on the quick stop ramp.
+        (
+            self.ramp(ctx, matches!(code, 2 | 6)),
+            !matches!(code, 0..=2),
+        )
+    }
+
+    fn stop_motion(&mut self) {
+        self.axis.stop_motion();
+    }
+
+    fn run_enabled(&mut self, ctx: Ctx<'_, '_>, seconds: f64) {
+        let mode = self.mode();
+        if mode == ModeOfOperation::CyclicSynchronousPosition {
+            // The axis takes each target at once; no interpolation between
+            // set-points is modelled.
+            let raw = ctx.get::<od::TargetPosition>().map_or(0, |v| v.0);
+            let (min, max) = self.position_limits(ctx);
+            let target = f64::from(raw).max(min).min(max);
+            if let Some(sm) = self.axis.sm.as_mut() {
+                sm.set_internal_limit(target != f64::from(raw));
+            }
+            self.axis.profiler = Profiler::at(target);
+            self.axis.goal = target;
+            return;
+        }
+        if mode != ModeOfOperation::ProfilePosition {
+            return;
+        }
+        let halt = self.axis.halted();
+        let goal = if halt {
+            let code = ctx.get::<od::HaltOptionCode>().map_or(1, |v| v.0);
+            Goal::Stop {
+                deceleration: self.ramp(ctx, code == 2),
+            }
+        } else {
+            match self.profile(ctx) {
+                Some((velocity, acceleration, deceleration)) => Goal::Target {
+                    target: self.axis.goal,
+                    velocity,
+                    acceleration,
+                    deceleration,
+                },
+                None => Goal::Stop {
+                    deceleration: self.ramp(ctx, true),
+                },
+            }
+        };
+        if self.axis.profiler.run(seconds, goal)
+            && !halt
+            && let Some(next) = self.axis.queued.take()
+        {
+            self.start_motion(ctx, next);
+        }
+    }
+
+    /// A new set-point (15.1.1 bits 4-6): the target, its limits, the
+    /// profile, then now (bit 5 or at rest) or after the running move.
+    fn start_set_point(&mut self, ctx: Ctx<'_, '_>, immediate: bool, relative: bool) {
+        let raw = f64::from(ctx.get::<od::TargetPosition>().map_or(0, |v| v.0));
+        let reference = self.axis.queued.unwrap_or(self.axis.goal);
+        let requested = if relative { reference + raw } else { raw };
+        let (min, max) = self.position_limits(ctx);
+        let target = requested.max(min).min(max);
+        let limited = target != requested;
+        if let Some(sm) = self.axis.sm.as_mut() {
+            sm.set_internal_limit(limited);
+        }
+        if limited {
+            ctx.emit(ZimmerAcsEvent::TargetLimited {
+                requested_um: requested.round() as i64,
+                limited_um: target.round() as i32,
+            });
+        }
+        if self.profile(ctx).is_none() {
+            self.fault(ctx, ZimmerErrors::ProfilerParametersNotValid);
+            return;
+        }
+        ctx.emit(ZimmerAcsEvent::SetPointAccepted {
+            target_um: target.round() as i32,
+            relative,
+            immediate,
+        });
+        if self.axis.take_set_point(target, immediate) {
+            self.start_motion(ctx, target);
+        }
+        self.axis.inside_since = None;
+    }
+
+    /// 15.5 0x6065/0x6066: outside the window for longer than the timeout
+    /// is a following error (bit 13, error 0x7387). 0xFFFFFFFF switches
+    /// the monitor off (CiA 402).
+    fn check_following_error(&mut self, ctx: Ctx<'_, '_>) {
+        let now = ctx.now();
+        if self.state() != Some(State::OperationEnabled) || !is_position_mode(self.mode()) {
+            self.axis.outside_since = None;
+            return;
+        }
+        let window = ctx
+            .get::<od::FollowingErrorWindow>()
+            .map_or(u32::MAX, |v| v.0);
+        let error = (self.axis.profiler.position - self.axis.actual).abs();
+        if window == u32::MAX || error <= f64::from(window) {
+            self.axis.outside_since = None;
+            return;
+        }
+        let since = *self.axis.outside_since.get_or_insert(now);
+        let timeout = ctx.get::<od::FollowingErrorTimeOut>().map_or(0, |v| v.0);
+        if now.saturating_duration_since(since) > Duration::from_millis(u64::from(timeout)) {
+            if let Some(sm) = self.axis.sm.as_mut() {
+                sm.set_position_following_error(true);
+            }
+            self.fault(ctx, ZimmerErrors::PositionFollowingError);
+        }
+    }
+
+    /// 15.1.2.1: target reached once the position stays within 0x21F1 of
+    /// the target for the window time; while halted it means standstill
+    /// (CiA 402).
+    fn update_target_reached(&mut self, ctx: Ctx<'_, '_>) {
+        let now = ctx.now();
+        let pp = self.state() == Some(State::OperationEnabled)
+            && self.mode() == ModeOfOperation::ProfilePosition;
+        let halt = self.axis.halted();
+        let window = f64::from(ctx.get::<od::PositionWindowX21F1>().map_or(0, |v| v.0));
+        let reached = if pp && self.axis.settled(halt, window) {
+            let since = *self.axis.inside_since.get_or_insert(now);
+            now.saturating_duration_since(since) >= POSITION_WINDOW_TIME
+        } else {
+            self.axis.inside_since = None;
+            false
+        };
+        if let Some(sm) = self.axis.sm.as_mut() {
+            sm.set_target_reached(reached);
+        }
+        if reached && self.axis.moving && !halt {
+            self.axis.moving = false;
+            ctx.emit(ZimmerAcsEvent::TargetReached {
+                position_um: self.axis.actual.round() as i32,
+            });
+        }
     }
 }
