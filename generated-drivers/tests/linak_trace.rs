@@ -74,74 +74,130 @@ fn pdo_mappings_are_the_manuals() {
     );
 }
 
+/// "1A0 00 00 00 81 01 00 00 C0": TPDO1 before the first Stop command.
+const STARTUP: [u8; 8] = [0x00, 0x00, 0x00, 0x81, 0x01, 0x00, 0x00, 0xC0];
+/// "1A0 1A 00 06 88 00 31 00 C0": running out, 2.6 mm.
+const RUNNING_OUT: [u8; 8] = [0x1A, 0x00, 0x06, 0x88, 0x00, 0x31, 0x00, 0xC0];
+
+/// What a TPDO1 of the trace reports by the manual.
+struct Feedback {
+    frame: [u8; 8],
+    position_mm: f64,
+    /// `None`: not running.
+    current_a: Option<f64>,
+    /// End stop in, end stop out, running out, running in.
+    flags: [bool; 4],
+    error: LinakErrors,
+    speed_mm_s: f64,
+}
+
+/// The TPDO1 frames of the trace, in its order.
+const TPDO1_FRAMES: [(&str, Feedback); 5] = [
+    (
+        "start-up, power-up lock",
+        Feedback {
+            frame: STARTUP,
+            position_mm: 0.0,
+            current_a: None,
+            flags: [true, false, false, false],
+            error: LinakErrors::PowerUpLock,
+            speed_mm_s: 0.0,
+        },
+    ),
+    (
+        "running out at 2.6 mm",
+        Feedback {
+            frame: RUNNING_OUT,
+            position_mm: 2.6,
+            current_a: Some(1.5),
+            flags: [false, false, true, false],
+            error: LinakErrors::NoError,
+            speed_mm_s: 4.9,
+        },
+    ),
+    (
+        // "1A0 F7 01 00 82 00 00 00 C0"
+        "end stop outwards reached, 50.3 mm",
+        Feedback {
+            frame: [0xF7, 0x01, 0x00, 0x82, 0x00, 0x00, 0x00, 0xC0],
+            position_mm: 50.3,
+            current_a: None,
+            flags: [false, true, false, false],
+            error: LinakErrors::NoError,
+            speed_mm_s: 0.0,
+        },
+    ),
+    (
+        // "1A0 60 00 06 90 00 32 00 C0"
+        "running in at 9.6 mm",
+        Feedback {
+            frame: [0x60, 0x00, 0x06, 0x90, 0x00, 0x32, 0x00, 0xC0],
+            position_mm: 9.6,
+            current_a: Some(1.5),
+            flags: [false, false, false, true],
+            error: LinakErrors::NoError,
+            speed_mm_s: 5.0,
+        },
+    ),
+    (
+        // "1A0 00 00 00 81 00 00 00 C0"
+        "end stop inwards, 0 mm, no error",
+        Feedback {
+            frame: [0x00, 0x00, 0x00, 0x81, 0x00, 0x00, 0x00, 0xC0],
+            position_mm: 0.0,
+            current_a: None,
+            flags: [true, false, false, false],
+            error: LinakErrors::NoError,
+            speed_mm_s: 0.0,
+        },
+    ),
+];
+
+#[test]
+fn tpdo1_frames_decode_to_the_manuals_values() {
+    for (what, expected) in TPDO1_FRAMES {
+        let fb = pdo::Tpdo1Feedback::decode(&expected.frame).unwrap();
+        assert_eq!(position_mm(fb.position), expected.position_mm, "{what}");
+        match expected.current_a {
+            Some(amps) => assert_eq!(current_a(fb.current), amps, "{what}"),
+            None => assert_eq!(
+                fb.current,
+                od::feedback::CurrentValue::NOT_RUNNING,
+                "{what}"
+            ),
+        }
+        let s = fb.status_flags;
+        let flags = [
+            s.end_stop_in(),
+            s.end_stop_out(),
+            s.running_out(),
+            s.running_in(),
+        ];
+        assert_eq!(flags, expected.flags, "{what}");
+        assert!(s.always_set(), "{what}");
+        assert_eq!(fb.error_code.kind(), expected.error, "{what}");
+        assert_eq!(speed_mm_s(fb.speed), expected.speed_mm_s, "{what}");
+    }
+}
+
 #[test]
 fn startup_frame_reports_power_up_lock() {
-    // "1A0 00 00 00 81 01 00 00 C0": TPDO1 before the first Stop command.
-    let fb = pdo::Tpdo1Feedback::decode(&[0x00, 0x00, 0x00, 0x81, 0x01, 0x00, 0x00, 0xC0]).unwrap();
-    assert_eq!(position_mm(fb.position), 0.0);
-    assert_eq!(fb.current, od::feedback::CurrentValue::NOT_RUNNING);
-    assert!(fb.status_flags.end_stop_in());
-    assert!(fb.status_flags.always_set());
-    assert!(!fb.status_flags.running_out() && !fb.status_flags.running_in());
-    assert_eq!(fb.error_code.kind(), LinakErrors::PowerUpLock);
+    let fb = pdo::Tpdo1Feedback::decode(&STARTUP).unwrap();
     assert_eq!(fb.error_code.to_raw(), 1);
     assert_eq!(
         fb.error_code.kind().remedy(),
         Some("Send Stop (0xFB03) or Clear error (0xFB00)")
     );
-    assert_eq!(speed_mm_s(fb.speed), 0.0);
 }
 
 #[test]
-fn running_out_at_2_6_mm() {
-    // "1A0 1A 00 06 88 00 31 00 C0": running out, 2.6 mm.
-    let fb = pdo::Tpdo1Feedback::decode(&[0x1A, 0x00, 0x06, 0x88, 0x00, 0x31, 0x00, 0xC0]).unwrap();
-    assert_eq!(position_mm(fb.position), 2.6);
-    assert_eq!(current_a(fb.current), 1.5);
-    assert!(fb.status_flags.running_out());
-    assert!(!fb.status_flags.running_in());
-    assert!(!fb.status_flags.end_stop_in() && !fb.status_flags.end_stop_out());
-    assert!(fb.status_flags.always_set());
-    assert_eq!(fb.error_code.kind(), LinakErrors::NoError);
-    assert_eq!(speed_mm_s(fb.speed), 4.9);
+fn running_out_frame_reports_the_aux_inputs() {
     // AUX byte 0xC0: inputs 1-3 at 0-25 % VCC, input 4 at 76-100 % (level 3 × 25 %).
+    let fb = pdo::Tpdo1Feedback::decode(&RUNNING_OUT).unwrap();
     assert_eq!(fb.aux_inputs.input_level_1(), 0);
     assert_eq!(fb.aux_inputs.input_level_3(), 0);
     assert_eq!(fb.aux_inputs.input_level_4(), 3);
     assert_eq!(fb.aux_inputs.input_level_4_value(), 75.0);
-}
-
-#[test]
-fn end_stop_out_at_50_3_mm() {
-    // "1A0 F7 01 00 82 00 00 00 C0": end stop outwards reached, 50.3 mm.
-    let fb = pdo::Tpdo1Feedback::decode(&[0xF7, 0x01, 0x00, 0x82, 0x00, 0x00, 0x00, 0xC0]).unwrap();
-    assert_eq!(position_mm(fb.position), 50.3);
-    assert_eq!(fb.current, od::feedback::CurrentValue::NOT_RUNNING);
-    assert!(fb.status_flags.end_stop_out());
-    assert!(!fb.status_flags.end_stop_in() && !fb.status_flags.running_out());
-    assert_eq!(fb.error_code.kind(), LinakErrors::NoError);
-    assert_eq!(speed_mm_s(fb.speed), 0.0);
-}
-
-#[test]
-fn running_in_at_9_6_mm() {
-    // "1A0 60 00 06 90 00 32 00 C0": running in, 9.6 mm.
-    let fb = pdo::Tpdo1Feedback::decode(&[0x60, 0x00, 0x06, 0x90, 0x00, 0x32, 0x00, 0xC0]).unwrap();
-    assert_eq!(position_mm(fb.position), 9.6);
-    assert_eq!(current_a(fb.current), 1.5);
-    assert!(fb.status_flags.running_in());
-    assert!(!fb.status_flags.running_out());
-    assert_eq!(fb.error_code.kind(), LinakErrors::NoError);
-    assert_eq!(speed_mm_s(fb.speed), 5.0);
-}
-
-#[test]
-fn end_stop_in_at_0_mm() {
-    // "1A0 00 00 00 81 00 00 00 C0": end stop inwards, 0 mm, no error.
-    let fb = pdo::Tpdo1Feedback::decode(&[0x00, 0x00, 0x00, 0x81, 0x00, 0x00, 0x00, 0xC0]).unwrap();
-    assert_eq!(position_mm(fb.position), 0.0);
-    assert!(fb.status_flags.end_stop_in());
-    assert_eq!(fb.error_code.kind(), LinakErrors::NoError);
 }
 
 fn command(position: od::command::PositionValue) -> pdo::Rpdo1Command {

@@ -40,7 +40,17 @@ fn linak_server(bus: &VirtualBus, stop: Arc<AtomicBool>) -> thread::JoinHandle<M
     store.insert_fixed(i, s, AccessRight::Rw, &[0, 0]);
     let (i, s) = address::<od::ManufacturerHardwareVersion>();
     store.insert(i, s, AccessRight::Ro, b"LA36 rev. C");
-    let node = NodeId::new(32).unwrap();
+    serve(bus, stop, NodeId::new(32).unwrap(), store)
+}
+
+/// An SDO server of `node` holding `store`, on `bus` in a thread until
+/// `stop`; the thread returns the store.
+fn serve(
+    bus: &VirtualBus,
+    stop: Arc<AtomicBool>,
+    node: NodeId,
+    store: MemoryStore,
+) -> thread::JoinHandle<MemoryStore> {
     let mut server = SdoServer::new(ServerConfig::new(Channel::default_for(node)), store);
     let mut port = bus.attach();
     thread::spawn(move || {
@@ -148,20 +158,7 @@ fn object_table_fills_an_sdo_store() {
     }
     let bus = VirtualBus::new();
     let stop = Arc::new(AtomicBool::new(false));
-    let mut server = SdoServer::new(ServerConfig::new(Channel::default_for(node)), store);
-    let mut port = bus.attach();
-    let stop_server = stop.clone();
-    let handle = thread::spawn(move || {
-        blocking::serve(
-            &mut port,
-            &Clock::new(),
-            &mut server,
-            &stop_server,
-            None,
-            |_| {},
-        )
-        .unwrap();
-    });
+    let handle = serve(&bus, stop.clone(), node, store);
     let mut client = SdoClient::new(bus.attach(), ClientConfig::new(Channel::default_for(node)));
     assert_eq!(client.read::<od::CobIdEmcy>().unwrap().to_raw(), 0xA0);
     assert_eq!(
@@ -201,21 +198,7 @@ fn array_elements_read_and_write_in_both_forms() {
     }
     store.insert_fixed(0x1016, 1, AccessRight::Rw, &[0, 0, 0, 0]);
     let node = NodeId::new(5).unwrap();
-    let mut server = SdoServer::new(ServerConfig::new(Channel::default_for(node)), store);
-    let mut port = bus.attach();
-    let server_stop = stop.clone();
-    let server = thread::spawn(move || {
-        blocking::serve(
-            &mut port,
-            &Clock::new(),
-            &mut server,
-            &server_stop,
-            None,
-            |_| {},
-        )
-        .unwrap();
-        server.into_store()
-    });
+    let server = serve(&bus, stop.clone(), node, store);
     let mut client = SdoClient::new(bus.attach(), ClientConfig::new(Channel::default_for(node)));
 
     // Compile-time form.

@@ -17,6 +17,10 @@ use std::process::ExitCode;
 
 use eds2rust_sim::harness::Args;
 
+#[allow(clippy::duplicate_mod, reason = "the demo includes the three examples")]
+#[path = "common/mod.rs"]
+mod common;
+
 #[allow(dead_code)]
 #[path = "zimmer_acs.rs"]
 mod zimmer_acs;
@@ -30,7 +34,7 @@ mod linak_techline;
 mod interroll_ec5000bi;
 
 /// Runs the three scenarios in order; stops at the first failure.
-fn run_all(args: &Args, out: &mut dyn Write) -> Result<(), Box<dyn std::error::Error>> {
+fn run_all(args: &Args, out: &mut dyn Write) -> common::Res<()> {
     writeln!(out, "== Zimmer ACS40/60 compact axis ==")?;
     zimmer_acs::run(args, out)?;
     writeln!(out, "\n== LINAK TECHLINE actuator ==")?;
@@ -42,21 +46,7 @@ fn run_all(args: &Args, out: &mut dyn Write) -> Result<(), Box<dyn std::error::E
 }
 
 fn main() -> ExitCode {
-    let args = match Args::from_env() {
-        Ok(args) => args,
-        Err(e) => {
-            eprintln!("demo: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    let mut out = std::io::stdout();
-    match run_all(&args, &mut out) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("demo: {e}");
-            ExitCode::FAILURE
-        }
-    }
+    common::main("demo", run_all)
 }
 
 #[cfg(test)]
@@ -66,15 +56,7 @@ mod demo_tests {
     /// The README's main command, on the virtual bus with fast mechanics.
     #[test]
     fn the_demo_runs_all_three_devices() {
-        let args = Args {
-            time_scale: 20.0,
-            ..Args::default()
-        };
-        let mut out = Vec::new();
-        run_all(&args, &mut out).unwrap_or_else(|e| {
-            panic!("{e}\n{}", String::from_utf8_lossy(&out));
-        });
-        let text = String::from_utf8_lossy(&out);
+        let ((), text) = common::run_at(20.0, run_all);
         assert!(
             text.ends_with("All three devices worked end to end.\n"),
             "{text}"

@@ -23,10 +23,11 @@
 //! RPDO transmitters each SYNC). With `--iface NAME --simulate` the three
 //! simulators run on a (v)can interface.
 
+#[path = "common/mod.rs"]
+mod common;
 #[path = "machine/sequences.rs"]
 mod sequences;
 
-use std::error::Error;
 use std::io::Write;
 use std::process::ExitCode;
 use std::time::Duration;
@@ -36,13 +37,12 @@ use eds2rust_machine::{actuator, axis, conveyor};
 use eds2rust_runtime::blocking;
 use eds2rust_runtime::boot::{Configuration, NetworkEvent, NetworkReport};
 use eds2rust_runtime::master::{self, MasterEvent};
-use eds2rust_runtime::od::NodeId;
 use eds2rust_sim::DeviceConfig;
 use eds2rust_sim::harness::{Args, Harness, MasterPort};
 use eds2rust_sim::models::{interroll_ec5000bi, linak_techline, zimmer_acs};
 use sequences::{ActuatorStroke, AxisMove, ConveyorRun, log};
 
-type Res<T> = Result<T, Box<dyn Error>>;
+use common::{Res, node};
 
 /// The axis's move in the cycle, µm.
 pub const AXIS_DISTANCE_UM: i32 = 40_000;
@@ -75,24 +75,7 @@ pub struct Summary {
 }
 
 fn main() -> ExitCode {
-    let args = match Args::from_env() {
-        Ok(args) => args,
-        Err(e) => {
-            eprintln!("machine: {e}");
-            return ExitCode::from(2);
-        }
-    };
-    match run(&args, &mut std::io::stdout()) {
-        Ok(_) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprintln!("machine: {e}");
-            ExitCode::FAILURE
-        }
-    }
-}
-
-fn node(id: u8) -> Res<NodeId> {
-    NodeId::new(id).ok_or_else(|| format!("node id {id}").into())
+    common::main("machine", run)
 }
 
 /// The three simulators on the harness's bus, at the node ids of the bus
@@ -319,15 +302,7 @@ mod machine_tests {
     /// The README's command, on the virtual bus with fast mechanics.
     #[test]
     fn the_machine_boots_and_runs_on_one_bus() {
-        let args = Args {
-            time_scale: 20.0,
-            ..Args::default()
-        };
-        let mut out = Vec::new();
-        let summary = run(&args, &mut out).unwrap_or_else(|e| {
-            panic!("{e}\n{}", String::from_utf8_lossy(&out));
-        });
-        let text = String::from_utf8_lossy(&out);
+        let (summary, text) = common::run_at(20.0, run);
         assert!(text.ends_with(&format!("{SUCCESS}\n")), "{text}");
         assert!(summary.report.booted, "{text}");
         assert_eq!(summary.report.slaves.len(), 3, "{text}");

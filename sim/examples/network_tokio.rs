@@ -139,36 +139,31 @@ fn main() -> Res<()> {
 }
 
 #[cfg(test)]
+#[path = "network/checks.rs"]
+mod checks;
+
+#[cfg(test)]
 mod tests {
     use super::*;
-    use eds2rust_runtime::boot::SlaveState;
 
     #[test]
     fn docs_network_md_shows_this_program() {
-        let docs = include_str!("../../docs/network.md");
-        let program = include_str!("network_tokio.rs");
-        let program = program.split("#[cfg(test)]").next().unwrap().trim_end();
-        assert!(
-            docs.contains(program),
-            "docs/network.md does not show {}",
-            "network_tokio.rs"
-        );
+        checks::assert_docs_show("network_tokio.rs", include_str!("network_tokio.rs"));
     }
 
     #[test]
     fn the_seed_machine_boots_on_the_virtual_bus() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../eds/machine/bus.yml");
         let runtime = tokio::runtime::Builder::new_multi_thread()
             .enable_all()
             .build()
             .unwrap();
         let report = runtime
-            .block_on(run(&path, None, Duration::from_millis(300)))
+            .block_on(run(
+                &checks::seed_machine(),
+                None,
+                Duration::from_millis(300),
+            ))
             .unwrap();
-        assert!(report.booted, "{report:?}");
-        for slave in &report.slaves {
-            assert_eq!(slave.state, SlaveState::Operational, "{slave:?}");
-            assert!(slave.identity_checked, "{slave:?}");
-        }
+        checks::assert_booted(&report);
     }
 }

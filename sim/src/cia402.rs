@@ -54,6 +54,8 @@
 //! run is refused too, unless 0x6502 declares it ([`declares_mode`]: taken,
 //! shown in 0x6061, the axis holds its position).
 
+pub(crate) mod axis;
+mod drive;
 mod logic;
 mod monitor;
 mod objects;
@@ -62,13 +64,13 @@ pub(crate) mod profiler;
 use std::time::Duration;
 
 use eds2rust_runtime::Instant;
-use eds2rust_runtime::cia402::{DeviceStateMachine, ModeOfOperation, State};
+use eds2rust_runtime::cia402::{ModeOfOperation, State};
 use eds2rust_runtime::od::ObjectInfo;
 use eds2rust_runtime::sdo::abort::AbortCode;
 
 use crate::{Behaviour, Context, Device, DeviceConfig};
+use axis::Axis;
 pub use objects::{declares_mode, mode_needs, supports_mode};
-use profiler::Profiler;
 
 /// Profile velocity (position units/s) when 0x6081 is absent or 0.
 pub const DEFAULT_PROFILE_VELOCITY: f64 = 10_000.0;
@@ -137,30 +139,16 @@ pub enum Cia402Event {
 /// The generic CiA 402 drive (see the module documentation).
 #[derive(Debug, Clone)]
 pub struct Cia402 {
-    time_scale: f64,
-    sm: Option<DeviceStateMachine>,
-    last: Option<Instant>,
-    /// Actual position (units); it survives power cycles.
-    actual: f64,
+    /// The axis (positions in the device's units).
+    axis: Axis,
     /// Actual velocity (units/s).
     actual_velocity: f64,
-    profiler: Profiler,
-    /// The target the generator heads for.
-    goal: f64,
-    /// The next set-point of a set of set-points.
-    queued: Option<f64>,
-    /// A new set-point waiting for the next step: (immediate, relative).
-    pending: Option<(bool, bool)>,
-    /// A move was started and its target reached is not reported yet.
-    moving: bool,
     /// Where the home switch is, in the current coordinates.
     home_switch: f64,
     /// Homing on the current position ends at this time.
     homing_in_place: Option<Instant>,
     /// The actual position follows the demand at most this fast (units/s).
     lag: Option<f64>,
-    outside_since: Option<Instant>,
-    inside_since: Option<Instant>,
     /// 0x605A was written; the state machine takes it in Switch on disabled.
     option_code_changed: bool,
     /// An EMCY with an error was sent and not yet reset.
@@ -177,21 +165,11 @@ impl Cia402 {
     /// A drive at position 0, following its demand exactly, in real time.
     pub fn new() -> Cia402 {
         Cia402 {
-            time_scale: 1.0,
-            sm: None,
-            last: None,
-            actual: 0.0,
+            axis: Axis::new(),
             actual_velocity: 0.0,
-            profiler: Profiler::at(0.0),
-            goal: 0.0,
-            queued: None,
-            pending: None,
-            moving: false,
             home_switch: 0.0,
             homing_in_place: None,
             lag: None,
-            outside_since: None,
-            inside_since: None,
             option_code_changed: false,
             emcy_sent: false,
         }
@@ -200,46 +178,40 @@ impl Cia402 {
     /// This model with the mechanics `factor` times faster than real time
     /// (a factor that is not a positive number leaves it unchanged).
     pub fn with_time_scale(mut self, factor: f64) -> Cia402 {
-        if factor.is_finite() && factor > 0.0 {
-            self.time_scale = factor;
-        }
+        self.axis.set_time_scale(factor);
         self
     }
 
     /// This model with the axis at `position` (units) at power-on; the
     /// home switch stays at 0.
     pub fn with_position(mut self, position: i64) -> Cia402 {
-        self.actual = position as f64;
-        self.profiler = Profiler::at(self.actual);
-        self.goal = self.actual;
+        self.axis.place(position as f64);
         self
     }
 
     /// The mechanics' speed-up over real time.
     pub fn time_scale(&self) -> f64 {
-        self.time_scale
+        self.axis.time_scale
     }
 
     /// The CiA 402 state (`None` before power-on).
     pub fn state(&self) -> Option<State> {
-        self.sm.as_ref().map(DeviceStateMachine::state)
+        self.axis.state()
     }
 
     /// The mode of operation in effect (`NoMode` before power-on).
     pub fn mode(&self) -> ModeOfOperation {
-        self.sm
-            .as_ref()
-            .map_or(ModeOfOperation::NoMode, DeviceStateMachine::mode)
+        self.axis.mode()
     }
 
     /// The actual position (units).
     pub fn position(&self) -> f64 {
-        self.actual
+        self.axis.actual
     }
 
     /// The demand position of the trajectory generator (units).
     pub fn demand(&self) -> f64 {
-        self.profiler.position
+        self.axis.profiler.position
     }
 
     /// The actual velocity (units/s).

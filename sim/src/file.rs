@@ -25,7 +25,7 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 use eds2rust::build::load_device;
-use eds2rust::diag::Severity;
+use eds2rust::diag::{Diagnostics, Severity};
 use eds2rust::input::Options;
 use eds2rust::ir::{self, Access, Device, Literal, ObjectKind, Value};
 use eds2rust_runtime::cia402::object::{CONTROLWORD, STATUSWORD};
@@ -122,25 +122,32 @@ pub fn load_with_overlays(
 ) -> Result<LoadedTable, LoadError> {
     let path = path.as_ref();
     let loaded = load_device(path, overlays, &Options::lenient());
+    let (device, warnings) = accept(path, loaded.device, &loaded.diagnostics)?;
+    Ok(from_device(path, &device, warnings))
+}
+
+/// What a reader made of `path` (`value`) with the warnings of
+/// `diagnostics`, or, when they have an error, every error.
+pub(crate) fn accept<T>(
+    path: &Path,
+    value: Option<T>,
+    diagnostics: &Diagnostics,
+) -> Result<(T, Vec<String>), LoadError> {
     let lines = |severity: Severity| -> Vec<String> {
-        loaded
-            .diagnostics
+        diagnostics
             .iter()
             .filter(|d| d.severity == severity)
             .map(ToString::to_string)
             .collect()
     };
     let errors = lines(Severity::Error);
-    let device = match loaded.device {
-        Some(device) if errors.is_empty() => device,
-        _ => {
-            return Err(LoadError {
-                path: path.to_path_buf(),
-                errors,
-            });
-        }
-    };
-    Ok(from_device(path, &device, lines(Severity::Warning)))
+    match value {
+        Some(value) if errors.is_empty() => Ok((value, lines(Severity::Warning))),
+        _ => Err(LoadError {
+            path: path.to_path_buf(),
+            errors,
+        }),
+    }
 }
 
 /// The table of `device`, already read from `path` (by a bus file's

@@ -85,13 +85,7 @@ impl Args {
                     let value = args
                         .next()
                         .ok_or_else(|| ArgsError("--time-scale needs a factor".into()))?;
-                    out.time_scale = value
-                        .parse()
-                        .ok()
-                        .filter(|v: &f64| v.is_finite() && *v > 0.0)
-                        .ok_or_else(|| {
-                            ArgsError(format!("--time-scale {value}: not a positive number"))
-                        })?;
+                    out.time_scale = time_scale(&value)?;
                 }
                 other => return Err(ArgsError(format!("unknown argument `{other}`"))),
             }
@@ -113,6 +107,15 @@ impl Args {
     pub fn simulates(&self) -> bool {
         self.iface.is_none() || self.simulate
     }
+}
+
+/// The factor of `--time-scale`: a positive number.
+pub fn time_scale(value: &str) -> Result<f64, ArgsError> {
+    value
+        .parse()
+        .ok()
+        .filter(|v: &f64| v.is_finite() && *v > 0.0)
+        .ok_or_else(|| ArgsError(format!("--time-scale {value}: not a positive number")))
 }
 
 /// The master's end of the bus. Non-exhaustive: the `SocketCan` variant

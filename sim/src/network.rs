@@ -30,7 +30,6 @@ mod simulation;
 use std::fmt;
 use std::path::{Path, PathBuf};
 
-use eds2rust::diag::{Diagnostics, Severity};
 use eds2rust::input::Options;
 use eds2rust::network::config::Configured;
 use eds2rust::network::model::Bus;
@@ -93,14 +92,6 @@ impl fmt::Display for FaultError {
 
 impl std::error::Error for FaultError {}
 
-fn lines(diagnostics: &Diagnostics, severity: Severity) -> Vec<String> {
-    diagnostics
-        .iter()
-        .filter(|d| d.severity == severity)
-        .map(ToString::to_string)
-        .collect()
-}
-
 impl Network {
     /// Reads the bus file at `path` and its device files (leniently, as
     /// `eds2rust check` without `--strict`), configures it as dcfgen does
@@ -108,27 +99,11 @@ impl Network {
     pub fn load(path: impl AsRef<Path>) -> Result<Network, LoadError> {
         let path = path.as_ref();
         let loaded = eds2rust::network::read_file(path, &Options::lenient());
-        let errors = lines(&loaded.diagnostics, Severity::Error);
-        let bus = match loaded.bus {
-            Some(bus) if errors.is_empty() => bus,
-            _ => {
-                return Err(LoadError {
-                    path: path.to_path_buf(),
-                    errors,
-                });
-            }
-        };
+        let (bus, mut warnings) = file::accept(path, loaded.bus, &loaded.diagnostics)?;
         let (configured, diagnostics) = eds2rust::network::configure(&bus);
-        let errors = lines(&diagnostics, Severity::Error);
-        if !errors.is_empty() {
-            return Err(LoadError {
-                path: path.to_path_buf(),
-                errors,
-            });
-        }
+        let (configured, configure_warnings) = file::accept(path, Some(configured), &diagnostics)?;
         let mut network = Network::from_bus(&bus, &configured);
-        let mut warnings = lines(&loaded.diagnostics, Severity::Warning);
-        warnings.extend(lines(&diagnostics, Severity::Warning));
+        warnings.extend(configure_warnings);
         warnings.append(&mut network.warnings);
         network.warnings = warnings;
         Ok(network)

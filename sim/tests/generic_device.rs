@@ -40,6 +40,20 @@ fn abort(code: AbortCode) -> Result<(), SdoError> {
     Err(SdoError::RemoteAbort(code))
 }
 
+/// The master's LSS switch state global to `state`.
+fn switch_global<B: eds2rust_sim::Behaviour>(b: &mut Bench<B>, state: LssState) {
+    let now = b.now();
+    b.master.lss.switch_global(now, state).expect("idle");
+}
+
+/// The master sends NMT `command` to `target` (at its next step).
+fn nmt<B: eds2rust_sim::Behaviour>(b: &mut Bench<B>, command: NmtCommand, target: NodeId) {
+    b.master
+        .nmt
+        .send(command, NmtTarget::Node(target))
+        .expect("queue");
+}
+
 #[test]
 fn boots_and_produces_the_heartbeat_of_0x1017() {
     let mut b = example_bench();
@@ -64,56 +78,32 @@ fn sdo_writes_are_checked_for_access_type_and_limits() {
     let mut b = example_bench();
     let n = node(5);
     // Access rights: write-only, read-only, missing index and subindex.
-    assert_eq!(
-        b.upload(n, 0x2001, 0).map(drop),
-        abort(AbortCode::ReadWriteOnly)
-    );
-    assert_eq!(
-        b.download(n, 0x6041, 0, &[0, 0]),
-        abort(AbortCode::WriteReadOnly)
-    );
-    assert_eq!(
-        b.download(n, 0x1018, 1, &[0; 4]),
-        abort(AbortCode::WriteReadOnly)
-    );
-    assert_eq!(
-        b.upload(n, 0x3000, 0).map(drop),
-        abort(AbortCode::ObjectDoesNotExist)
-    );
-    assert_eq!(
-        b.upload(n, 0x1018, 9).map(drop),
-        abort(AbortCode::SubindexDoesNotExist)
-    );
-    // Type: 0x6060 is INTEGER8.
-    assert_eq!(
-        b.download(n, 0x6060, 0, &[1, 0]),
-        abort(AbortCode::LengthTooHigh)
-    );
-    assert_eq!(
-        b.download(n, 0x1017, 0, &[1]),
-        abort(AbortCode::LengthTooLow)
-    );
-    // Limits: 0x6060 is -4..=10, 0x2000 (REAL32) 1.0..=100.0.
-    assert_eq!(
-        b.download(n, 0x6060, 0, &[11]),
-        abort(AbortCode::ValueTooHigh)
-    );
-    assert_eq!(
-        b.download(n, 0x6060, 0, &[(-5i8) as u8]),
-        abort(AbortCode::ValueTooLow)
-    );
+    for (index, sub, code) in [
+        (0x2001, 0, AbortCode::ReadWriteOnly),
+        (0x3000, 0, AbortCode::ObjectDoesNotExist),
+        (0x1018, 9, AbortCode::SubindexDoesNotExist),
+    ] {
+        let read = b.upload(n, index, sub).map(drop);
+        assert_eq!(read, abort(code), "read {index:#06X}/{sub}");
+    }
+    let (half, big) = (0.5f32.to_le_bytes(), 100.5f32.to_le_bytes());
+    for (index, sub, data, code) in [
+        (0x6041, 0, &[0, 0][..], AbortCode::WriteReadOnly),
+        (0x1018, 1, &[0; 4], AbortCode::WriteReadOnly),
+        // Type: 0x6060 is INTEGER8.
+        (0x6060, 0, &[1, 0], AbortCode::LengthTooHigh),
+        (0x1017, 0, &[1], AbortCode::LengthTooLow),
+        // Limits: 0x6060 is -4..=10, 0x2000 (REAL32) 1.0..=100.0.
+        (0x6060, 0, &[11], AbortCode::ValueTooHigh),
+        (0x6060, 0, &[(-5i8) as u8], AbortCode::ValueTooLow),
+        (0x2000, 0, &half, AbortCode::ValueTooLow),
+        (0x2000, 0, &big, AbortCode::ValueTooHigh),
+    ] {
+        let write = b.download(n, index, sub, data);
+        assert_eq!(write, abort(code), "write {data:?} to {index:#06X}/{sub}");
+    }
     b.download(n, 0x6060, 0, &[(-4i8) as u8])
         .expect("-4 is the low limit");
-    let half = 0.5f32.to_le_bytes();
-    assert_eq!(
-        b.download(n, 0x2000, 0, &half),
-        abort(AbortCode::ValueTooLow)
-    );
-    let big = 100.5f32.to_le_bytes();
-    assert_eq!(
-        b.download(n, 0x2000, 0, &big),
-        abort(AbortCode::ValueTooHigh)
-    );
     b.download(n, 0x2000, 0, &50.0f32.to_le_bytes())
         .expect("50.0");
     assert_eq!(b.upload(n, 0x2000, 0).expect("read"), 50.0f32.to_le_bytes());
@@ -170,10 +160,7 @@ fn pdo_mapping_follows_the_cia_301_order_and_rules() {
         .expect("enable");
     // Operational: the new layout goes out at once, then on the 100 ms
     // event timer: position (0), statusword (0).
-    b.master
-        .nmt
-        .send(NmtCommand::Start, NmtTarget::Node(n))
-        .expect("queue");
+    nmt(&mut b, NmtCommand::Start, n);
     b.run_for(Duration::from_millis(150));
     let tpdos: Vec<String> = b
         .trace_lines()
@@ -186,10 +173,7 @@ fn pdo_mapping_follows_the_cia_301_order_and_rules() {
 #[test]
 fn rpdos_write_the_mapped_entries_and_length_errors_raise_emcy() {
     let mut b = example_bench();
-    b.master
-        .nmt
-        .send(NmtCommand::Start, NmtTarget::Node(node(5)))
-        .expect("queue");
+    nmt(&mut b, NmtCommand::Start, node(5));
     b.run_for(Duration::from_millis(1));
     // RPDO1: controlword 0x000F, target position 1000.
     b.inject(&frame(0x205, &[0x0F, 0x00, 0xE8, 0x03, 0x00, 0x00]));
@@ -222,10 +206,7 @@ fn rpdos_write_the_mapped_entries_and_length_errors_raise_emcy() {
         Some("085#2082000000000000")
     );
     // Pre-operational: RPDOs are ignored.
-    b.master
-        .nmt
-        .send(NmtCommand::EnterPreOperational, NmtTarget::Node(node(5)))
-        .expect("queue");
+    nmt(&mut b, NmtCommand::EnterPreOperational, node(5));
     b.run_for(Duration::from_millis(1));
     b.inject(&frame(0x205, &[0x07, 0x00, 0, 0, 0, 0]));
     assert_eq!(b.device.table().get(0x6040, 0), Some(&[0x06, 0x00][..]));
@@ -284,11 +265,7 @@ fn an_unconfigured_lss_slave_gets_its_node_id_and_moves_its_sdo_server() {
     // Unconfigured: no boot-up, no heartbeat (701#00 is the master's).
     assert_eq!(b.trace_lines(), ["701#00"]);
     b.trace.clear();
-    let now = b.now();
-    b.master
-        .lss
-        .switch_global(now, LssState::Configuration)
-        .expect("idle");
+    switch_global(&mut b, LssState::Configuration);
     b.run_for(Duration::from_millis(1));
     let now = b.now();
     b.master.lss.configure_node_id(now, node(9)).expect("idle");
@@ -296,11 +273,7 @@ fn an_unconfigured_lss_slave_gets_its_node_id_and_moves_its_sdo_server() {
         e,
         MasterEvent::Lss(_)
     )));
-    let now = b.now();
-    b.master
-        .lss
-        .switch_global(now, LssState::Waiting)
-        .expect("idle");
+    switch_global(&mut b, LssState::Waiting);
     // CiA 305: an unconfigured slave that got a node id resets its
     // communication by itself when switched back to waiting.
     b.run_for(Duration::from_millis(1));

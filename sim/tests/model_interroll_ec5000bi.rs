@@ -94,6 +94,24 @@ fn has(b: &Bench<Ec5000Bi>, line: &str) -> bool {
     lines(b).iter().any(|l| l == line)
 }
 
+/// A drive at node 127 in real time, enabled in profile velocity mode with
+/// target velocity `mm_s` (0x60FF).
+fn conveying(mm_s: i32) -> Bench<Ec5000Bi> {
+    let mut b = bench(1.0);
+    enable(&mut b, N127);
+    down(&mut b, N127, 0x60FF, 0, &mm_s.to_le_bytes());
+    b
+}
+
+/// When the frames with CAN id `id` (`1FF#`) were sent.
+fn sent_at(b: &Bench<Ec5000Bi>, id: &str) -> Vec<Instant> {
+    b.trace
+        .iter()
+        .filter(|(_, f)| f.to_string().starts_with(id))
+        .map(|(t, _)| *t)
+        .collect()
+}
+
 #[test]
 fn delivered_at_node_127_with_its_identity() {
     let mut b = bench(1.0);
@@ -260,9 +278,7 @@ fn velocity_mode_ramps_runs_and_halts() {
 
 #[test]
 fn target_below_the_minimum_velocity_holds() {
-    let mut b = bench(1.0);
-    enable(&mut b, N127);
-    down(&mut b, N127, 0x60FF, 0, &10i32.to_le_bytes());
+    let mut b = conveying(10);
     b.run_for(Duration::from_millis(300));
     assert_eq!(i32_at(&mut b, N127, 0x606C), 0);
     // Above the maximum profile velocity (607Fh 2000): limited, bit 11.
@@ -273,9 +289,7 @@ fn target_below_the_minimum_velocity_holds() {
 
 #[test]
 fn mode_change_follows_the_matrix_of_chapter_4_1() {
-    let mut b = bench(1.0);
-    enable(&mut b, N127);
-    down(&mut b, N127, 0x60FF, 0, &300i32.to_le_bytes());
+    let mut b = conveying(300);
     b.run_for(Duration::from_millis(200));
     // Running (52): no change to position mode.
     let r = b.download(node(N127), 0x6060, 0, &[1]);
@@ -438,12 +452,7 @@ fn tpdos_follow_chapter_8() {
     assert!(has(&b, "3FF#500200000000"));
     // Event timer 2000 ms: sent again without a change.
     b.run_for(Duration::from_millis(2100));
-    let tpdo1: Vec<Instant> = b
-        .trace
-        .iter()
-        .filter(|(_, f)| f.to_string().starts_with("1FF#"))
-        .map(|(t, _)| *t)
-        .collect();
+    let tpdo1 = sent_at(&b, "1FF#");
     assert_eq!(tpdo1.len(), 2);
     assert_eq!(
         tpdo1[1].saturating_duration_since(tpdo1[0]),
@@ -455,12 +464,7 @@ fn tpdos_follow_chapter_8() {
     controlword(&mut b, N127, 0x0007);
     controlword(&mut b, N127, 0x000F);
     b.run_for(Duration::from_millis(300));
-    let times: Vec<Instant> = b
-        .trace
-        .iter()
-        .filter(|(_, f)| f.to_string().starts_with("1FF#"))
-        .map(|(t, _)| *t)
-        .collect();
+    let times = sent_at(&b, "1FF#");
     assert!(times.len() >= 2);
     for w in times.windows(2) {
         assert!(w[1].saturating_duration_since(w[0]) >= Duration::from_millis(100));

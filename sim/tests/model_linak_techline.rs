@@ -17,8 +17,8 @@ use eds2rust_runtime::{CanId, Frame, Instant};
 use eds2rust_sim::SimEvent;
 use eds2rust_sim::bench::Bench;
 use eds2rust_sim::models::linak_techline::{
-    Direction, LinakTechline, LinakTechlineEvent, NODE, Refusal, StopReason, default_config,
-    simulator_with,
+    Direction, LinakTechline, LinakTechlineEvent, MANUAL_TRACE, NODE, Refusal, StopReason,
+    default_config, simulator_with,
 };
 
 type B = Bench<LinakTechline>;
@@ -45,18 +45,23 @@ fn fast() -> LinakTechline {
     LinakTechline::new().with_time_scale(10.0)
 }
 
-/// The manual's start-up up to the Stop command: 0x1016 sub 1 = 0x000100C8,
-/// NMT start, Stop (p. 28).
+/// A booted actuator after the manual's start-up ([`start_up`]).
 fn started(model: LinakTechline) -> B {
     let mut b = bench_with(model);
     b.run_for(ms(150));
+    start_up(&mut b, ms(50));
+    b
+}
+
+/// The manual's start-up up to the Stop command: 0x1016 sub 1 = 0x000100C8,
+/// NMT start, Stop (p. 28), with `pause` after NMT start and after Stop.
+fn start_up(b: &mut B, pause: Duration) {
     b.download(NODE, 0x1016, 1, &[0xC8, 0x00, 0x01, 0x00])
         .expect("0x1016");
-    nmt(&mut b, NmtCommand::Start);
-    b.run_for(ms(50));
-    rpdo(&mut b, [0x03, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
-    b.run_for(ms(50));
-    b
+    nmt(b, NmtCommand::Start);
+    b.run_for(pause);
+    command(b, 0xFB03);
+    b.run_for(pause);
 }
 
 fn nmt(b: &mut B, cmd: NmtCommand) {
@@ -70,6 +75,20 @@ fn nmt(b: &mut B, cmd: NmtCommand) {
 /// RPDO1 of node 32 (0x220) from the master.
 fn rpdo(b: &mut B, data: [u8; 8]) {
     b.inject(&frame(0x220, &data));
+}
+
+/// RPDO1 with the position command `position` (0xFB00 clear error, 0xFB01
+/// run out, 0xFB02 run in, 0xFB03 stop, ...) and every other field at its
+/// default 0xFB.
+fn command(b: &mut B, position: u16) {
+    let [lo, hi] = position.to_le_bytes();
+    rpdo(b, [lo, hi, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+}
+
+/// Jams the spindle (`true`) or frees it.
+fn jam(b: &mut B, jammed: bool) {
+    let now = b.now();
+    b.device.with_model(now, |m, _| m.set_jammed(jammed));
 }
 
 /// The trace from `from` on, without the master's heartbeats.
@@ -87,6 +106,17 @@ fn tpdos_since(b: &B, from: usize) -> Vec<String> {
         .into_iter()
         .filter(|l| l.starts_with("1A0#"))
         .collect()
+}
+
+/// `frame` was on the bus since trace line `mark`.
+fn assert_sent_since(b: &B, mark: usize, frame: &str) {
+    let lines = lines_since(b, mark);
+    assert!(lines.iter().any(|l| l == frame), "{frame} not in {lines:?}");
+}
+
+/// The last TPDO1 on the bus.
+fn last_tpdo(b: &B) -> Option<String> {
+    tpdos_since(b, 0).pop()
 }
 
 fn read(b: &mut B, index: u16, sub: u8) -> Vec<u8> {
@@ -116,26 +146,11 @@ fn start_up_follows_the_manuals_trace() {
     assert_eq!(b.trace_lines(), ["701#00", "720#00", "701#05"]);
     assert_eq!(b.trace[2].0, Instant::from_millis(100));
     let mark = b.trace.len();
-    b.download(NODE, 0x1016, 1, &[0xC8, 0x00, 0x01, 0x00])
-        .expect("0x1016");
-    nmt(&mut b, NmtCommand::Start);
-    b.run_for(ms(20));
-    rpdo(&mut b, [0x03, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
-    b.run_for(ms(20));
+    start_up(&mut b, ms(20));
     // Exactly the manual's frames, in its order: SDO write and answer, NMT
     // start, TPDO1 "stop required" (error 1), Stop, end stop in, no error.
     // No TPDO2 (the trace shows none).
-    assert_eq!(
-        lines_since(&b, mark),
-        [
-            "620#23161001C8000100",
-            "5A0#6016100100000000",
-            "000#0120",
-            "1A0#00000081010000C0",
-            "220#03FBFBFBFBFB0000",
-            "1A0#00000081000000C0",
-        ]
-    );
+    assert_eq!(lines_since(&b, mark), MANUAL_TRACE[2..8]);
     // Standing still, TPDO1 repeats on its event timer (0x1800 sub 5, 250 ms).
     let mark = b.trace.len();
     b.run_for(ms(1000));
@@ -146,7 +161,7 @@ fn start_up_follows_the_manuals_trace() {
 fn runs_out_to_the_end_stop_and_back() {
     let mut b = started(fast());
     let mark = b.trace.len();
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(1500));
     let out = tpdos_since(&b, mark);
     // Running out: current 0x06 (1.5 A), status 0x88, speed 0x0032 (5.0
@@ -155,7 +170,7 @@ fn runs_out_to_the_end_stop_and_back() {
     assert_eq!(out.last().map(String::as_str), Some("1A0#F7010082000000C0"));
     assert_eq!(b.device.behaviour().position_mm(), 50.3);
     let mark = b.trace.len();
-    rpdo(&mut b, [0x02, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB02);
     b.run_for(ms(1500));
     let back = tpdos_since(&b, mark);
     assert!(back.iter().any(|l| &l[8..16] == "06900032"), "{back:?}");
@@ -180,7 +195,7 @@ fn moving_feedback_comes_once_per_event_timer() {
     // Real time: 50.3 mm at 5 mm/s take about 10 s.
     let mut b = started(LinakTechline::new());
     let mark = b.trace.len();
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(2000));
     let times: Vec<u64> = b.trace[mark..]
         .iter()
@@ -202,14 +217,11 @@ fn runs_to_a_position_and_stops_on_an_invalid_value() {
     // 20.0 mm = 200 = 0x00C8: standing there, no end stop, status 0x80.
     rpdo(&mut b, [0xC8, 0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(1000));
-    assert_eq!(
-        tpdos_since(&b, 0).last().map(String::as_str),
-        Some("1A0#C8000080000000C0")
-    );
+    assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#C8000080000000C0"));
     // Run out, then 0xFB06 (invalid): the actuator ramps down and stays.
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(200));
-    rpdo(&mut b, [0x06, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB06);
     b.run_for(ms(500));
     let stopped = b.device.behaviour().position_mm();
     assert!(stopped > 20.0 && stopped < 50.0, "{stopped}");
@@ -256,7 +268,7 @@ fn power_up_lock_refuses_runs_until_stop() {
         .expect("0x1016");
     nmt(&mut b, NmtCommand::Start);
     model_events(&mut b);
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(300));
     assert_eq!(b.device.behaviour().position_mm(), 0.0);
     assert!(
@@ -266,12 +278,9 @@ fn power_up_lock_refuses_runs_until_stop() {
         })
     );
     // Clear error (0xFB00) releases it as well as Stop does.
-    rpdo(&mut b, [0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB00);
     b.run_for(ms(20));
-    assert_eq!(
-        tpdos_since(&b, 0).last().map(String::as_str),
-        Some("1A0#00000081000000C0")
-    );
+    assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#00000081000000C0"));
     // Leaving and entering Operational arms the lock again (p. 27).
     nmt(&mut b, NmtCommand::EnterPreOperational);
     let mark = b.trace.len();
@@ -282,7 +291,7 @@ fn power_up_lock_refuses_runs_until_stop() {
 #[test]
 fn heartbeat_loss_stops_sets_error_5_and_sends_emcy_0x8130() {
     let mut b = started(LinakTechline::new());
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(500));
     assert_eq!(b.device.behaviour().running(), Some(Direction::Out));
     let now = b.now();
@@ -311,17 +320,13 @@ fn heartbeat_loss_stops_sets_error_5_and_sends_emcy_0x8130() {
     b.run_for(ms(150));
     assert_eq!(read(&mut b, 0x2001, 3), [0x80]);
     assert_eq!(read(&mut b, 0x2001, 4), [0x05]);
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(100));
     assert_eq!(b.device.behaviour().running(), None);
     let mark = b.trace.len();
-    rpdo(&mut b, [0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB00);
     b.run_for(ms(20));
-    let lines = lines_since(&b, mark);
-    assert!(
-        lines.contains(&"0A0#0000000000000000".to_string()),
-        "{lines:?}"
-    );
+    assert_sent_since(&b, mark, "0A0#0000000000000000");
     assert_eq!(read(&mut b, 0x2001, 4), [0x00]);
     assert_eq!(read(&mut b, 0x1001, 0), [0x00]);
     // Stop reason 2048 "communication interrupted" (p. 46), one
@@ -333,25 +338,20 @@ fn heartbeat_loss_stops_sets_error_5_and_sends_emcy_0x8130() {
 #[test]
 fn jammed_spindle_is_error_12_with_emcy_0xff05() {
     let mut b = started(fast());
-    let now = b.now();
-    b.device.with_model(now, |m, _| m.set_jammed(true));
+    jam(&mut b, true);
     let mark = b.trace.len();
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(200));
-    let lines = lines_since(&b, mark);
     // Code 0xFF05 "position does not change", register 0x81 (generic +
     // manufacturer); feedback error 12 (0x0C), not running, end stop in.
-    assert!(
-        lines.contains(&"0A0#05FF810000000000".to_string()),
-        "{lines:?}"
-    );
+    assert_sent_since(&b, mark, "0A0#05FF810000000000");
     assert_eq!(
         tpdos_since(&b, mark).last().map(String::as_str),
         Some("1A0#000000810C0000C0")
     );
     assert_eq!(read(&mut b, 0x4000, 0x26), [0x00, 0x02]); // reason 512
     // Run out is refused while the error is there.
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(100));
     assert!(
         model_events(&mut b).contains(&LinakTechlineEvent::CommandRefused {
@@ -360,13 +360,12 @@ fn jammed_spindle_is_error_12_with_emcy_0xff05() {
         })
     );
     // Freed and cleared (p. 29): EMCY error reset, error 0, moves again.
-    let now = b.now();
-    b.device.with_model(now, |m, _| m.set_jammed(false));
+    jam(&mut b, false);
     let mark = b.trace.len();
-    rpdo(&mut b, [0x00, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB00);
     b.run_for(ms(20));
-    assert!(lines_since(&b, mark).contains(&"0A0#0000000000000000".to_string()));
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    assert_sent_since(&b, mark, "0A0#0000000000000000");
+    command(&mut b, 0xFB01);
     b.run_for(ms(1500));
     assert_eq!(b.device.behaviour().position_mm(), 50.3);
 }
@@ -377,23 +376,17 @@ fn obstacle_trips_the_current_limit() {
     let now = b.now();
     b.device
         .with_model(now, |m, _| m.set_obstacle_out(Some(20.0)));
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB01);
     b.run_for(ms(1000));
     // Stopped at 20.0 mm (0x00C8), status 0x84 (overcurrent), error 0.
-    assert_eq!(
-        tpdos_since(&b, 0).last().map(String::as_str),
-        Some("1A0#C8000084000000C0")
-    );
+    assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#C8000084000000C0"));
     assert_eq!(read(&mut b, 0x4000, 0x1C), [1]); // default limit, out
     assert_eq!(read(&mut b, 0x4000, 0x26), [0x08, 0x00]); // reason 8
     assert_eq!(read(&mut b, 0x4000, 0x10), [16]); // 4.0 A peak
     // Run in is allowed (no error code) and clears the flag.
-    rpdo(&mut b, [0x02, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB02);
     b.run_for(ms(1000));
-    assert_eq!(
-        tpdos_since(&b, 0).last().map(String::as_str),
-        Some("1A0#00000081000000C0")
-    );
+    assert_eq!(last_tpdo(&b).as_deref(), Some("1A0#00000081000000C0"));
     // A user limit of 1.0 A (0x04) is below the running current: cut off at
     // once, counted as a user-limit overload (0x4000 sub 0x1E).
     rpdo(&mut b, [0x01, 0xFB, 0x04, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
@@ -442,16 +435,14 @@ fn identity_and_lss_address() {
 #[test]
 fn recovery_run_moves_despite_error_12() {
     let mut b = started(fast());
-    let now = b.now();
-    b.device.with_model(now, |m, _| m.set_jammed(true));
-    rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    jam(&mut b, true);
+    command(&mut b, 0xFB01);
     b.run_for(ms(200));
     assert_eq!(read(&mut b, 0x2001, 4), [0x0C]);
-    let now = b.now();
-    b.device.with_model(now, |m, _| m.set_jammed(false));
+    jam(&mut b, false);
     // Recovery run out (0xFB04) is taken with error 12 present; the error
     // stays until Clear error.
-    rpdo(&mut b, [0x04, 0xFB, 0xFB, 0xFB, 0xFB, 0xFB, 0x00, 0x00]);
+    command(&mut b, 0xFB04);
     b.run_for(ms(1500));
     assert_eq!(b.device.behaviour().position_mm(), 50.3);
     assert_eq!(read(&mut b, 0x2001, 4), [0x0C]);
@@ -463,11 +454,11 @@ fn speed_setting_scales_the_feedback_speed() {
     // Speed 0x64 = 100 × 0.5 % = 50 %: 2.5 mm/s = 0x0019 in 0.1 mm/s.
     rpdo(&mut b, [0x01, 0xFB, 0xFB, 0x64, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(1000));
-    let last = tpdos_since(&b, 0).last().cloned().unwrap_or_default();
+    let last = last_tpdo(&b).unwrap_or_default();
     assert_eq!(&last[8..18], "0688001900", "{last}");
     // Changed during the run (p. 26): 100 % again, 5.0 mm/s.
     rpdo(&mut b, [0x01, 0xFB, 0xFB, 0xC8, 0xFB, 0xFB, 0x00, 0x00]);
     b.run_for(ms(600));
-    let last = tpdos_since(&b, 0).last().cloned().unwrap_or_default();
+    let last = last_tpdo(&b).unwrap_or_default();
     assert_eq!(&last[8..18], "0688003200", "{last}");
 }

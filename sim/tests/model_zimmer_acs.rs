@@ -94,6 +94,41 @@ fn model_events(b: &mut Bench<ZimmerAcs>) -> Vec<ZimmerAcsEvent> {
         .collect()
 }
 
+/// The state machine's transitions (CiA 402 numbers) since the last call.
+fn transitions(b: &mut Bench<ZimmerAcs>) -> Vec<u8> {
+    model_events(b)
+        .into_iter()
+        .filter_map(|e| match e {
+            ZimmerAcsEvent::StateChanged { transition, .. } => Some(transition),
+            _ => None,
+        })
+        .collect()
+}
+
+/// A new set-point: the target `target_um` (0x607A), then controlword
+/// `cw` with bit 4 (and bit 5 or 6 as `cw` says).
+fn set_point(b: &mut Bench<ZimmerAcs>, target_um: i32, cw: u16) {
+    write(b, 0x607A, 0, &target_um.to_le_bytes());
+    controlword(b, cw);
+}
+
+/// An axis at time scale `scale`, enabled, 200 ms into a move to
+/// `target_um`.
+fn moving(scale: f64, target_um: i32) -> Bench<ZimmerAcs> {
+    let mut b = bench_with(ZimmerAcs::new().with_time_scale(scale));
+    enable(&mut b);
+    set_point(&mut b, target_um, 0x1F);
+    b.run_for(ms(200));
+    b
+}
+
+/// The STO inputs (true = 24 V).
+fn set_sto(b: &mut Bench<ZimmerAcs>, sto1: bool, sto2: bool) {
+    let now = b.now();
+    b.device
+        .with_model(now, |m, ctx| m.set_sto(ctx, sto1, sto2));
+}
+
 fn frames_with_id(b: &Bench<ZimmerAcs>, start: usize, id: &str) -> Vec<String> {
     lines_from(b, start)
         .into_iter()
@@ -146,14 +181,7 @@ fn boots_at_node_40_and_enables_with_6_7_15_over_sdo() {
     assert!(b.device.behaviour().clamp_released());
     // Mode of operation: 1 (profile position) by default (15.5).
     assert_eq!(read(&mut b, 0x6061, 0), [1]);
-    let transitions: Vec<u8> = model_events(&mut b)
-        .into_iter()
-        .filter_map(|e| match e {
-            ZimmerAcsEvent::StateChanged { transition, .. } => Some(transition),
-            _ => None,
-        })
-        .collect();
-    assert_eq!(transitions, [0, 1, 2, 3, 4]);
+    assert_eq!(transitions(&mut b), [0, 1, 2, 3, 4]);
 }
 
 #[test]
@@ -203,22 +231,19 @@ fn profile_position_move_with_the_set_point_handshake() {
 fn relative_targets_and_targets_beyond_the_stroke() {
     let mut b = bench_with(ZimmerAcs::new().with_time_scale(10.0));
     enable(&mut b);
-    write(&mut b, 0x607A, 0, &30_000i32.to_le_bytes());
-    controlword(&mut b, 0x1F);
+    set_point(&mut b, 30_000, 0x1F);
     controlword(&mut b, 0x0F);
     b.run_for(ms(200));
     assert_eq!(position(&mut b), 30_000);
     // Relative (bit 6): +25 mm from the last target.
-    write(&mut b, 0x607A, 0, &25_000i32.to_le_bytes());
-    controlword(&mut b, 0x5F);
+    set_point(&mut b, 25_000, 0x5F);
     controlword(&mut b, 0x4F);
     b.run_for(ms(200));
     assert_eq!(position(&mut b), 55_000);
     assert_eq!(statusword(&mut b) & 0x0800, 0);
     // 150 mm on an ACS40 (100 mm stroke): clamped to 0x3007/2, bit 11.
     assert_eq!(read(&mut b, 0x3007, 2), 100_000i32.to_le_bytes());
-    write(&mut b, 0x607A, 0, &150_000i32.to_le_bytes());
-    controlword(&mut b, 0x1F);
+    set_point(&mut b, 150_000, 0x1F);
     controlword(&mut b, 0x0F);
     b.run_for(ms(200));
     assert_eq!(position(&mut b), 100_000);
@@ -287,9 +312,7 @@ fn sto_dropping_in_operation_enabled_is_0x3283_and_blocks_switching_on() {
     assert_eq!(read(&mut b, 0x251A, 0), [0x17, 0x00]);
     enable(&mut b);
     let start = b.trace.len();
-    let now = b.now();
-    b.device
-        .with_model(now, |m, ctx| m.set_sto(ctx, false, false));
+    set_sto(&mut b, false, false);
     b.run_for(ms(1));
     assert_eq!(frames_with_id(&b, start, "0A8#"), ["0A8#8332000000000000"]);
     // Fault, no voltage (bit 4 = 0, status LED blue/red, 11.3).
@@ -305,9 +328,7 @@ fn sto_dropping_in_operation_enabled_is_0x3283_and_blocks_switching_on() {
     assert_eq!(frames_with_id(&b, start, "0A8#"), ["0A8#8032000000000000"]);
     assert_eq!(statusword(&mut b), 0x4008);
     // Inputs back: reset and enable work again.
-    let now = b.now();
-    b.device
-        .with_model(now, |m, ctx| m.set_sto(ctx, true, true));
+    set_sto(&mut b, true, true);
     controlword(&mut b, 0x80);
     enable(&mut b);
     assert_eq!(statusword(&mut b), 0x4437);
@@ -316,9 +337,7 @@ fn sto_dropping_in_operation_enabled_is_0x3283_and_blocks_switching_on() {
 #[test]
 fn differing_sto_inputs_latch_0x3282_until_power_on() {
     let mut b = bench();
-    let now = b.now();
-    b.device
-        .with_model(now, |m, ctx| m.set_sto(ctx, true, false));
+    set_sto(&mut b, true, false);
     b.run_for(ms(10));
     // STO1, supply OK, abnormal fault; no report (16.1.3 irregular STO).
     assert_eq!(read(&mut b, 0x251A, 0), [0x0D, 0x00]);
@@ -328,9 +347,7 @@ fn differing_sto_inputs_latch_0x3282_until_power_on() {
     assert_eq!(frames_with_id(&b, start, "0A8#"), ["0A8#8232000000000000"]);
     assert_eq!(statusword(&mut b), 0x0008);
     // Latched: inputs back high, fault reset refused.
-    let now = b.now();
-    b.device
-        .with_model(now, |m, ctx| m.set_sto(ctx, true, true));
+    set_sto(&mut b, true, true);
     controlword(&mut b, 0x80);
     assert_eq!(statusword(&mut b), 0x0008);
     // Report = NOR(STO1, STO2) = 0, abnormal fault stays.
@@ -356,8 +373,7 @@ fn the_clamping_element_follows_the_state_machine_unless_overridden() {
     write(&mut b, 0x2129, 0, &[2, 0]);
     enable(&mut b);
     assert!(!b.device.behaviour().clamp_released());
-    write(&mut b, 0x607A, 0, &20_000i32.to_le_bytes());
-    controlword(&mut b, 0x1F);
+    set_point(&mut b, 20_000, 0x1F);
     b.run_for(ms(300));
     // Fault, following error, angle found; the acknowledge went with
     // Operation enabled.
@@ -420,11 +436,7 @@ fn store_and_restore_take_only_their_signatures() {
 
 #[test]
 fn the_position_survives_a_power_cycle_and_the_controlword_does_not() {
-    let mut b = bench_with(ZimmerAcs::new().with_time_scale(10.0));
-    enable(&mut b);
-    write(&mut b, 0x607A, 0, &12_345i32.to_le_bytes());
-    controlword(&mut b, 0x1F);
-    b.run_for(ms(200));
+    let mut b = moving(10.0, 12_345);
     write(&mut b, 0x1010, 1, b"save");
     let now = b.now();
     b.device.power_cycle(now);
@@ -475,11 +487,7 @@ fn modes_and_option_codes_outside_the_manual_are_refused() {
 
 #[test]
 fn quick_stop_ramps_down_then_disables() {
-    let mut b = bench_with(ZimmerAcs::new().with_time_scale(2.0));
-    enable(&mut b);
-    write(&mut b, 0x607A, 0, &90_000i32.to_le_bytes());
-    controlword(&mut b, 0x1F);
-    b.run_for(ms(200));
+    let mut b = moving(2.0, 90_000);
     let moving = position(&mut b);
     assert!(moving > 0 && moving < 90_000);
     model_events(&mut b);
@@ -490,14 +498,7 @@ fn quick_stop_ramps_down_then_disables() {
     assert_eq!(statusword(&mut b), 0x4040);
     let stopped = position(&mut b);
     assert!(stopped >= moving && stopped < 90_000);
-    let transitions: Vec<u8> = model_events(&mut b)
-        .into_iter()
-        .filter_map(|e| match e {
-            ZimmerAcsEvent::StateChanged { transition, .. } => Some(transition),
-            _ => None,
-        })
-        .collect();
-    assert_eq!(transitions, [11, 12]);
+    assert_eq!(transitions(&mut b), [11, 12]);
 }
 
 #[test]

@@ -115,13 +115,7 @@ pub fn parse(args: impl IntoIterator<Item = String>) -> Result<Args, Failure> {
             }
             "--time-scale" => {
                 let value = args.next().unwrap_or_default();
-                out.time_scale = value
-                    .parse()
-                    .ok()
-                    .filter(|v: &f64| v.is_finite() && *v > 0.0)
-                    .ok_or_else(|| {
-                        Failure(format!("--time-scale {value}: not a positive number"))
-                    })?;
+                out.time_scale = harness::time_scale(&value).map_err(|e| Failure(e.0))?;
             }
             other if other.starts_with("--") => {
                 return Err(Failure(format!("unknown argument `{other}`\n{USAGE}")));

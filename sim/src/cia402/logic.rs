@@ -9,6 +9,7 @@ use eds2rust_runtime::cia402::{
     State,
 };
 
+use super::axis::{Drive, Step};
 use super::objects::{self as obj, int};
 use super::profiler::{Goal, Profiler};
 use super::{Cia402, Cia402Event};
@@ -47,11 +48,10 @@ impl Cia402 {
     /// Power-on (and NMT reset node): a new state machine; the axis stays
     /// where it is.
     pub(super) fn power_on(&mut self, ctx: Ctx<'_, '_>) {
-        self.sm = None;
-        self.last = None;
+        self.homing_in_place = None;
+        self.axis.power_off();
         self.option_code_changed = false;
         self.emcy_sent = false;
-        self.stop_motion();
         self.begin(ctx);
         self.finish(ctx);
     }
@@ -59,7 +59,7 @@ impl Cia402 {
     /// Before handling an input: the state machine exists, the mechanics
     /// are at `ctx.now()`.
     pub(super) fn begin(&mut self, ctx: Ctx<'_, '_>) {
-        if self.sm.is_none() {
+        if self.axis.sm.is_none() {
             let table = ctx.table();
             // Without 0x6060 nothing can choose a mode: profile position.
             let mode = int(table, obj::MODES_OF_OPERATION)
@@ -70,11 +70,9 @@ impl Cia402 {
                         .then_some(1)
                 })
                 .unwrap_or(0);
-            let code = obj::quick_stop_option_code(table);
-            let mut sm = DeviceStateMachine::new(ctx.now(), machine_config(code));
-            sm.set_mode(ModeOfOperation::from_i8(mode as i8));
-            self.sm = Some(sm);
-            self.last = Some(ctx.now());
+            let config = machine_config(obj::quick_stop_option_code(table));
+            let mode = ModeOfOperation::from_i8(mode as i8);
+            self.axis.switch_on(ctx.now(), config, mode);
         }
         self.advance(ctx);
     }
@@ -85,12 +83,7 @@ impl Cia402 {
         // Effects can cause transitions, which are events again; a few
         // rounds settle every chain.
         for _ in 0..8 {
-            let mut events = Vec::new();
-            if let Some(sm) = self.sm.as_mut() {
-                while let Some(event) = sm.poll_event() {
-                    events.push(event);
-                }
-            }
+            let events = self.axis.poll_events();
             if events.is_empty() {
                 break;
             }
@@ -118,30 +111,14 @@ impl Cia402 {
         // The new machine's transitions 0 and 1 end where the old one was.
         while sm.poll_event().is_some() {}
         sm.set_mode(mode);
-        self.sm = Some(sm);
-    }
-
-    fn stop_motion(&mut self) {
-        self.homing_in_place = None;
-        self.profiler = Profiler::at(self.actual);
-        self.goal = self.actual;
-        self.queued = None;
-        self.pending = None;
-        self.moving = false;
-        self.outside_since = None;
-        self.inside_since = None;
+        self.axis.sm = Some(sm);
     }
 
     /// Raises a fault with `code`: 0x603F, 0x1001 bit 0, EMCY, Fault.
     pub(super) fn fault(&mut self, ctx: Ctx<'_, '_>, code: u16) {
-        let now = ctx.now();
-        let Some(sm) = self.sm.as_mut() else {
-            return;
-        };
-        if sm.state().is_fault() && sm.fault_code() == Some(code) {
+        if !self.axis.raise_fault(ctx.now(), code) {
             return;
         }
-        sm.raise_fault(now, code);
         publish(ctx, obj::ERROR_CODE, 0, i64::from(code));
         let register = int(ctx.table(), obj::ERROR_REGISTER).unwrap_or(0) | 1;
         publish(ctx, obj::ERROR_REGISTER, 0, register);
@@ -153,7 +130,7 @@ impl Cia402 {
     pub(super) fn apply_controlword(&mut self, ctx: Ctx<'_, '_>) {
         let cw = int(ctx.table(), obj::CONTROLWORD).unwrap_or(0);
         let now = ctx.now();
-        if let Some(sm) = self.sm.as_mut() {
+        if let Some(sm) = self.axis.sm.as_mut() {
             sm.apply_controlword(now, Controlword(cw as u16));
         }
     }
@@ -161,7 +138,7 @@ impl Cia402 {
     pub(super) fn apply_mode(&mut self, ctx: Ctx<'_, '_>) {
         let mode = int(ctx.table(), obj::MODES_OF_OPERATION).unwrap_or(0);
         let mode = ModeOfOperation::from_i8(mode as i8);
-        let Some(sm) = self.sm.as_mut() else {
+        let Some(sm) = self.axis.sm.as_mut() else {
             return;
         };
         if sm.mode() != mode {
@@ -170,16 +147,16 @@ impl Cia402 {
             sm.set_internal_limit(false);
             // A change of mode in motion brakes (the new mode's goal then
             // applies); at rest nothing moves.
-            self.queued = None;
-            self.pending = None;
-            self.moving = false;
-            self.goal = self.profiler.position;
+            self.axis.queued = None;
+            self.axis.pending = None;
+            self.axis.moving = false;
+            self.axis.goal = self.axis.profiler.position;
         }
     }
 
     fn on_event(&mut self, ctx: Ctx<'_, '_>, event: DeviceEvent) {
-        match event {
-            DeviceEvent::Transition { number, from, to } => {
+        match self.axis.take_event(event) {
+            Some(Step::Transition { number, from, to }) => {
                 ctx.emit(Cia402Event::StateChanged {
                     transition: number,
                     from,
@@ -187,23 +164,15 @@ impl Cia402 {
                 });
                 self.on_transition(ctx, number, to);
             }
-            // Taken at the next step, when an RPDO has written the target
-            // mapped after the controlword too.
-            DeviceEvent::NewSetPoint {
-                immediate,
-                relative,
-            } if self.mode() == ModeOfOperation::ProfilePosition => {
-                self.pending = Some((immediate, relative));
-            }
-            DeviceEvent::HomingStarted => self.start_homing(ctx),
-            _ => {}
+            Some(Step::HomingStarted) => self.start_homing(ctx),
+            None => {}
         }
     }
 
     fn on_transition(&mut self, ctx: Ctx<'_, '_>, number: u8, to: State) {
         let now = ctx.now();
         let homing = self.mode() == ModeOfOperation::Homing;
-        if let Some(sm) = self.sm.as_mut()
+        if let Some(sm) = self.axis.sm.as_mut()
             && !homing
         {
             // Set again by the monitor.
@@ -212,13 +181,14 @@ impl Cia402 {
         match to {
             State::QuickStopActive => {
                 let code = self
+                    .axis
                     .sm
                     .as_ref()
                     .map_or(2, |sm| sm.config().quick_stop_option_code);
                 if code == 0 {
                     // Disable drive function: the axis coasts.
                     self.stop_motion();
-                    if let Some(sm) = self.sm.as_mut() {
+                    if let Some(sm) = self.axis.sm.as_mut() {
                         sm.complete_quick_stop(now);
                     }
                 }
@@ -236,48 +206,19 @@ impl Cia402 {
             if std::mem::take(&mut self.emcy_sent) {
                 ctx.emcy(0, [0; 5]);
             }
-            if let Some(sm) = self.sm.as_mut() {
-                sm.set_position_following_error(false);
-                sm.set_internal_limit(false);
-            }
+            self.axis.clear_fault_bits();
         }
     }
 
     /// Runs the mechanics from the last input to `ctx.now()`.
     fn advance(&mut self, ctx: Ctx<'_, '_>) {
-        let now = ctx.now();
-        let elapsed = self
-            .last
-            .map_or(Duration::ZERO, |last| now.saturating_duration_since(last));
-        self.last = Some(now);
-        let seconds = elapsed.as_secs_f64() * self.time_scale;
-        match self.state() {
-            Some(State::OperationEnabled) => self.run_enabled(ctx, seconds),
-            Some(State::QuickStopActive) => {
-                let (code, stays) = self.sm.as_ref().map_or((2, false), |sm| {
-                    (
-                        sm.config().quick_stop_option_code,
-                        sm.config().stays_in_quick_stop(),
-                    )
-                });
-                let goal = Goal::Stop {
-                    deceleration: obj::braking(ctx.table(), i64::from(code)),
-                };
-                if self.profiler.run(seconds, goal)
-                    && !stays
-                    && let Some(sm) = self.sm.as_mut()
-                {
-                    sm.complete_quick_stop(now);
-                }
-            }
-            _ => self.stop_motion(),
-        }
+        let seconds = self.run_mechanics(ctx);
         self.follow(seconds);
     }
 
     /// The actual position follows the demand (at most the lag speed).
     fn follow(&mut self, seconds: f64) {
-        let before = self.actual;
+        let before = self.axis.actual;
         let movable = matches!(
             self.state(),
             Some(State::OperationEnabled | State::QuickStopActive)
@@ -288,15 +229,15 @@ impl Cia402 {
         }
         match self.lag {
             None => {
-                self.actual = self.profiler.position;
-                self.actual_velocity = self.profiler.velocity;
+                self.axis.actual = self.axis.profiler.position;
+                self.actual_velocity = self.axis.profiler.velocity;
             }
             Some(speed) => {
-                let gap = self.profiler.position - self.actual;
+                let gap = self.axis.profiler.position - self.axis.actual;
                 let step = (speed * seconds).min(gap.abs());
-                self.actual += step * gap.signum();
+                self.axis.actual += step * gap.signum();
                 self.actual_velocity = if seconds > 0.0 {
-                    (self.actual - before) / seconds
+                    (self.axis.actual - before) / seconds
                 } else {
                     0.0
                 };
@@ -305,164 +246,35 @@ impl Cia402 {
     }
 
     pub(super) fn halted(&self) -> bool {
-        self.sm.as_ref().is_some_and(|sm| sm.controlword().halt())
+        self.axis.halted()
     }
 
     /// The braking goal of a halt (0x605D; 1, slow down ramp, without it).
-    fn halt_goal(&self, ctx: Ctx<'_, '_>) -> Goal {
+    pub(super) fn halt_goal(&self, ctx: Ctx<'_, '_>) -> Goal {
         let code = int(ctx.table(), obj::HALT_OPTION_CODE).unwrap_or(1);
         Goal::Stop {
             deceleration: obj::braking(ctx.table(), code),
         }
     }
 
-    fn run_enabled(&mut self, ctx: Ctx<'_, '_>, seconds: f64) {
-        let halt = self.halted();
-        match self.mode() {
-            ModeOfOperation::CyclicSynchronousPosition => {
-                // The axis takes each target at once; no interpolation.
-                let raw = int(ctx.table(), obj::TARGET_POSITION).unwrap_or(0) as f64;
-                let target = self.limit(ctx, raw);
-                self.profiler = Profiler::at(target);
-                self.goal = target;
-            }
-            ModeOfOperation::ProfilePosition => {
-                let goal = if halt {
-                    self.halt_goal(ctx)
-                } else {
-                    let p = obj::profile(ctx.table());
-                    Goal::Target {
-                        target: self.goal,
-                        velocity: p.velocity,
-                        acceleration: p.acceleration,
-                        deceleration: p.deceleration,
-                    }
-                };
-                if self.profiler.run(seconds, goal)
-                    && !halt
-                    && let Some(next) = self.queued.take()
-                {
-                    self.start_motion(next);
-                }
-            }
-            ModeOfOperation::ProfileVelocity => {
-                let goal = if halt {
-                    self.halt_goal(ctx)
-                } else {
-                    let p = obj::profile(ctx.table());
-                    let target = int(ctx.table(), obj::TARGET_VELOCITY).unwrap_or(0) as f64;
-                    Goal::Velocity {
-                        velocity: obj::limit_velocity(ctx.table(), target),
-                        acceleration: p.acceleration,
-                        deceleration: p.deceleration,
-                    }
-                };
-                self.profiler.run(seconds, goal);
-                // At a software limit the axis stops (bit 11).
-                let position = self.profiler.position;
-                let limited = self.limit(ctx, position);
-                if limited != position {
-                    self.profiler = Profiler::at(limited);
-                }
-                self.goal = self.profiler.position;
-            }
-            ModeOfOperation::Homing => {
-                let homing = self
-                    .sm
-                    .as_ref()
-                    .is_some_and(DeviceStateMachine::homing_active);
-                let goal = if halt || !homing || self.homing_in_place.is_some() {
-                    self.halt_goal(ctx)
-                } else {
-                    let p = obj::homing_profile(ctx.table());
-                    Goal::Target {
-                        target: self.home_switch,
-                        velocity: p.velocity,
-                        acceleration: p.acceleration,
-                        deceleration: p.deceleration,
-                    }
-                };
-                if let Some(at) = self.homing_in_place {
-                    if homing && ctx.now() >= at {
-                        self.homing_in_place = None;
-                        self.home_here(ctx);
-                    }
-                } else if self.profiler.run(seconds, goal) && homing && !halt {
-                    self.home_here(ctx);
-                }
-            }
-            _ => {
-                self.profiler.run(
-                    seconds,
-                    Goal::Stop {
-                        deceleration: obj::profile(ctx.table()).deceleration,
-                    },
-                );
-            }
-        }
-    }
-
     /// `position` within the software limits; sets bit 11 when clamped
     /// (and clears it when not).
-    fn limit(&mut self, ctx: Ctx<'_, '_>, position: f64) -> f64 {
+    pub(super) fn limit(&mut self, ctx: Ctx<'_, '_>, position: f64) -> f64 {
         let limited = match obj::position_limits(ctx.table()) {
             Some((min, max)) => position.clamp(min, max),
             None => position,
         };
-        if let Some(sm) = self.sm.as_mut() {
+        if let Some(sm) = self.axis.sm.as_mut() {
             sm.set_internal_limit(limited != position);
         }
         limited
     }
 
-    fn start_motion(&mut self, target: f64) {
-        self.goal = target;
-        self.moving = true;
-        self.inside_since = None;
-    }
-
-    /// A new set-point (bits 4-6): the target, its limits, then now (bit 5
-    /// or at rest) or after the running move.
-    pub(super) fn start_set_point(&mut self, ctx: Ctx<'_, '_>, immediate: bool, relative: bool) {
-        let raw = int(ctx.table(), obj::TARGET_POSITION).unwrap_or(0) as f64;
-        let requested = if relative {
-            // 0x60F2 bits 0-1: 0 preceding target, 1 demand, 2 actual.
-            let option = int(ctx.table(), obj::POSITIONING_OPTION_CODE).unwrap_or(0) & 3;
-            let reference = match option {
-                1 => self.profiler.position,
-                2 => self.actual,
-                _ => self.queued.unwrap_or(self.goal),
-            };
-            reference + raw
-        } else {
-            raw
-        };
-        let target = self.limit(ctx, requested);
-        if target != requested {
-            ctx.emit(Cia402Event::TargetLimited {
-                requested: requested.round() as i64,
-                limited: target.round() as i64,
-            });
-        }
-        ctx.emit(Cia402Event::SetPointAccepted {
-            target: target.round() as i64,
-            relative,
-            immediate,
-        });
-        let busy = !self.profiler.at_rest() || self.profiler.position != self.goal;
-        if immediate || !busy {
-            self.queued = None;
-            self.start_motion(target);
-        } else {
-            self.queued = Some(target);
-        }
-    }
-
     /// Homing started (bit 4 rising in homing mode).
     fn start_homing(&mut self, ctx: Ctx<'_, '_>) {
-        self.queued = None;
-        self.pending = None;
-        self.moving = true;
+        self.axis.queued = None;
+        self.axis.pending = None;
+        self.axis.moving = true;
         let method = int(ctx.table(), obj::HOMING_METHOD).unwrap_or(0);
         self.homing_in_place = HOMING_ON_POSITION
             .contains(&method)
@@ -471,14 +283,14 @@ impl Cia402 {
 
     /// The axis is at the home switch: the position becomes the home
     /// offset; homing attained.
-    fn home_here(&mut self, ctx: Ctx<'_, '_>) {
+    pub(super) fn home_here(&mut self, ctx: Ctx<'_, '_>) {
         let offset = int(ctx.table(), obj::HOME_OFFSET).unwrap_or(0) as f64;
-        self.actual = offset;
-        self.profiler = Profiler::at(offset);
-        self.goal = offset;
+        self.axis.actual = offset;
+        self.axis.profiler = Profiler::at(offset);
+        self.axis.goal = offset;
         self.home_switch = offset;
-        self.moving = false;
-        if let Some(sm) = self.sm.as_mut() {
+        self.axis.moving = false;
+        if let Some(sm) = self.axis.sm.as_mut() {
             sm.homing_done(true);
         }
         ctx.emit(Cia402Event::HomingAttained {

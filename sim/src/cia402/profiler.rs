@@ -103,17 +103,15 @@ impl Profiler {
 
     fn step(&mut self, h: f64, goal: Goal) {
         match goal {
-            Goal::Stop { deceleration } => {
-                let v = self.velocity;
-                let dv = deceleration.max(f64::MIN_POSITIVE) * h;
-                let next = if v.abs() <= dv {
-                    0.0
-                } else {
-                    v - dv * v.signum()
-                };
-                self.position += (v + next) / 2.0 * h;
-                self.velocity = next;
-            }
+            // Braking is a ramp to velocity 0 (never speeding up).
+            Goal::Stop { deceleration } => self.step(
+                h,
+                Goal::Velocity {
+                    velocity: 0.0,
+                    acceleration: deceleration,
+                    deceleration,
+                },
+            ),
             Goal::Velocity {
                 velocity,
                 acceleration,
@@ -128,12 +126,7 @@ impl Profiler {
                 } else {
                     deceleration
                 };
-                let dv = rate.max(f64::MIN_POSITIVE) * h;
-                let next = if (velocity - v).abs() <= dv {
-                    velocity
-                } else {
-                    v + dv * (velocity - v).signum()
-                };
+                let next = toward(v, velocity, rate.max(f64::MIN_POSITIVE) * h);
                 self.position += (v + next) / 2.0 * h;
                 self.velocity = next;
             }
@@ -193,6 +186,18 @@ impl Profiler {
                 self.velocity = next * direction;
             }
         }
+    }
+}
+
+/// `v` moved towards `target` by at most `step` (a speed ramp; the seed
+/// models' mechanics use it too).
+pub(crate) fn toward(v: f64, target: f64, step: f64) -> f64 {
+    if (target - v).abs() <= step {
+        target
+    } else if target > v {
+        v + step
+    } else {
+        v - step
     }
 }
 

@@ -71,14 +71,9 @@ fn mapping(table: &ObjectTable, map_index: u16) -> Vec<Mapped> {
 /// n - 1). TPDOs with a transmission type the transmitter does not run
 /// (252/253, remote only) are left out.
 pub(crate) fn tpdos(table: &ObjectTable, sync_cob_id: u16) -> Vec<Tpdo> {
-    (0..512u16)
-        .filter(|n| table.has_index(0x1800 + n))
-        .filter_map(|n| {
+    valid_pdos(table, 0x1800)
+        .filter_map(|(n, cob_id)| {
             let comm = 0x1800 + n;
-            let cob_id = PdoCobId(table.get_uint(comm, 1)? as u32);
-            if !cob_id.is_valid() {
-                return None;
-            }
             let transmission = table.get_uint(comm, 2).unwrap_or(255) as u8;
             let mut config =
                 TransmitterConfig::new(cob_id, TransmissionType::from_raw(transmission));
@@ -96,17 +91,22 @@ pub(crate) fn tpdos(table: &ObjectTable, sync_cob_id: u16) -> Vec<Tpdo> {
         .collect()
 }
 
+/// The PDOs whose communication parameter record is at `base + n` (n
+/// from 0, at most 512) with a valid COB-ID (sub 1): (n, COB-ID).
+fn valid_pdos(table: &ObjectTable, base: u16) -> impl Iterator<Item = (u16, PdoCobId)> + '_ {
+    (0..512u16)
+        .filter(move |n| table.has_index(base + n))
+        .filter_map(move |n| {
+            let cob_id = PdoCobId(table.get_uint(base + n, 1)? as u32);
+            cob_id.is_valid().then_some((n, cob_id))
+        })
+}
+
 /// Every valid RPDO of the table (0x1400 + n - 1, mapping 0x1600 + n - 1).
 pub(crate) fn rpdos(table: &ObjectTable) -> Vec<Rpdo> {
-    (0..512u16)
-        .filter(|n| table.has_index(0x1400 + n))
-        .filter_map(|n| {
-            let comm = 0x1400 + n;
-            let cob_id = PdoCobId(table.get_uint(comm, 1)? as u32);
-            if !cob_id.is_valid() {
-                return None;
-            }
-            let transmission = table.get_uint(comm, 2).unwrap_or(255);
+    valid_pdos(table, 0x1400)
+        .filter_map(|(n, cob_id)| {
+            let transmission = table.get_uint(0x1400 + n, 2).unwrap_or(255);
             Some(Rpdo {
                 can_id: cob_id.checked_can_id().ok()?,
                 synchronous: transmission <= 240,

@@ -107,6 +107,25 @@ pub const DEFAULT_RAMP_MS: u16 = 300;
 /// error 12 (mechanical time). Modelled.
 pub const JAM_DETECTION: Duration = Duration::from_millis(500);
 
+/// The manual's start-up trace (p. 28): every frame that does not depend
+/// on the motion, in its order (master heartbeat, boot-up, 0x1016 sub 1
+/// written and confirmed, NMT start, TPDO1 "stop required", Stop, TPDO1,
+/// run out, TPDO1 at the outer end stop, run in, TPDO1 at the inner one).
+pub const MANUAL_TRACE: [&str; 12] = [
+    "701#05",
+    "720#00",
+    "620#23161001C8000100",
+    "5A0#6016100100000000",
+    "000#0120",
+    "1A0#00000081010000C0",
+    "220#03FBFBFBFBFB0000",
+    "1A0#00000081000000C0",
+    "220#01FBFBFBFBFB0000",
+    "1A0#F7010082000000C0",
+    "220#02FBFBFBFBFB0000",
+    "1A0#00000081000000C0",
+];
+
 /// A direction of travel.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Direction {

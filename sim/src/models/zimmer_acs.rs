@@ -55,12 +55,12 @@ use std::time::Duration;
 use eds2rust_drivers::zimmer_acs::errors::ZimmerErrors;
 use eds2rust_drivers::zimmer_acs::{DEFAULT_NODE_ID, od};
 use eds2rust_runtime::Instant;
-use eds2rust_runtime::cia402::{DeviceStateMachine, State};
+use eds2rust_runtime::cia402::State;
 use eds2rust_runtime::lss::BitRate;
 use eds2rust_runtime::od::{Entry, NodeId};
 use eds2rust_runtime::sdo::abort::AbortCode;
 
-use crate::cia402::profiler::Profiler;
+use crate::cia402::axis::Axis;
 use crate::{Behaviour, Context, Device, DeviceConfig};
 pub use factory::Variant;
 
@@ -143,23 +143,9 @@ pub enum ZimmerAcsEvent {
 #[derive(Debug, Clone)]
 pub struct ZimmerAcs {
     variant: Variant,
-    time_scale: f64,
-    sm: Option<DeviceStateMachine>,
-    last: Option<Instant>,
-    /// Actual carriage position (µm); it survives power cycles.
-    actual: f64,
-    profiler: Profiler,
-    /// The target the generator heads for (µm).
-    goal: f64,
-    /// The next set-point of a set of set-points (µm).
-    queued: Option<f64>,
-    /// A new set-point waiting for the next step: (immediate, relative).
-    pending: Option<(bool, bool)>,
-    /// A move was started and its target reached is not reported yet.
-    moving: bool,
+    /// The CiA 402 axis (positions in µm).
+    axis: Axis,
     blocked: bool,
-    outside_since: Option<Instant>,
-    inside_since: Option<Instant>,
     angle_determined: bool,
     clamp_released: bool,
     sto1: bool,
@@ -179,18 +165,8 @@ impl ZimmerAcs {
     pub fn new() -> ZimmerAcs {
         ZimmerAcs {
             variant: Variant::Acs40,
-            time_scale: 1.0,
-            sm: None,
-            last: None,
-            actual: 0.0,
-            profiler: Profiler::at(0.0),
-            goal: 0.0,
-            queued: None,
-            pending: None,
-            moving: false,
+            axis: Axis::new(),
             blocked: false,
-            outside_since: None,
-            inside_since: None,
             angle_determined: false,
             clamp_released: false,
             sto1: true,
@@ -203,9 +179,7 @@ impl ZimmerAcs {
     /// This model with the mechanics `factor` times faster than real time
     /// (a factor that is not a positive number leaves it unchanged).
     pub fn with_time_scale(mut self, factor: f64) -> ZimmerAcs {
-        if factor.is_finite() && factor > 0.0 {
-            self.time_scale = factor;
-        }
+        self.axis.set_time_scale(factor);
         self
     }
 
@@ -217,9 +191,7 @@ impl ZimmerAcs {
 
     /// This model with the carriage at `position_um` (µm) at power-on.
     pub fn with_position_um(mut self, position_um: i32) -> ZimmerAcs {
-        self.actual = f64::from(position_um);
-        self.profiler = Profiler::at(self.actual);
-        self.goal = self.actual;
+        self.axis.place(f64::from(position_um));
         self
     }
 
@@ -232,7 +204,7 @@ impl ZimmerAcs {
 
     /// The mechanics' speed-up over real time.
     pub fn time_scale(&self) -> f64 {
-        self.time_scale
+        self.axis.time_scale
     }
 
     /// The size of the axis.
@@ -242,17 +214,17 @@ impl ZimmerAcs {
 
     /// The CiA 402 state (`None` before power-on).
     pub fn state(&self) -> Option<State> {
-        self.sm.as_ref().map(DeviceStateMachine::state)
+        self.axis.state()
     }
 
     /// The actual carriage position (µm).
     pub fn position_um(&self) -> f64 {
-        self.actual
+        self.axis.actual
     }
 
     /// The demand position of the trajectory generator (µm).
     pub fn demand_um(&self) -> f64 {
-        self.profiler.position
+        self.axis.profiler.position
     }
 
     /// Whether the clamping element is released.

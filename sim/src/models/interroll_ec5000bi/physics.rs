@@ -92,14 +92,7 @@ pub(crate) fn sign(v: f64) -> f64 {
 pub(crate) fn ramp(v: f64, target: f64, accel: f64, decel: f64, dt: f64) -> f64 {
     let speeding_up = target.abs() > v.abs() && (v == 0.0 || v.signum() == target.signum());
     let rate = if speeding_up { accel } else { decel };
-    let step = rate.max(0.0) * dt;
-    if (target - v).abs() <= step {
-        target
-    } else if target > v {
-        v + step
-    } else {
-        v - step
-    }
+    crate::cia402::profiler::toward(v, target, rate.max(0.0) * dt)
 }
 
 /// The electrical and thermal state of the motor.

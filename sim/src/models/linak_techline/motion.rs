@@ -3,6 +3,8 @@
 //! 4-5, p. 30-31; 0x4000 sub 3-6, p. 40). Pure arithmetic in mechanical
 //! time, no bus.
 
+use crate::cia402::profiler::toward;
+
 /// Position resolution of the feedback (0.1 mm/bit, p. 32); a target
 /// closer than half of it counts as reached.
 const ARRIVAL_MM: f64 = 0.05;
@@ -68,17 +70,6 @@ pub struct Piston {
     pub velocity: f64,
     /// Stroke length in mm.
     pub stroke: f64,
-}
-
-/// `v` moved towards `target` by at most `step`.
-fn toward(v: f64, target: f64, step: f64) -> f64 {
-    if (target - v).abs() <= step {
-        target
-    } else if target > v {
-        v + step
-    } else {
-        v - step
-    }
 }
 
 impl Piston {

@@ -1,19 +1,41 @@
 //! The workings of [`ZimmerAcs`]: the state machine's events and their
 //! effects, set-points, the mechanics, the monitors, and what is published
 //! in the object table.
+//!
+//! What the manual and CiA 402 agree on is the shared axis
+//! ([`crate::cia402::axis`]: state machine, trajectory generator,
+//! set-points, settling, fault raise and reset). What stays here is where
+//! the manual says something of its own:
+//! - 0x6060 (11.1.2, 15.5 "The default value is 1"): only 1 and 8 exist, so no
+//!   homing starts and no other mode runs.
+//! - Statusword bit 4 (the LED table: "StatusWord Bit 04 (Voltage enabled) = 1 ⇒
+//!   Regler ist aktiv") is the power stage with STO (16.1.3), and bit 9
+//!   is not set: the state machine sets neither.
+//! - 0x605A (15.5): 0, 1, 2, 5, 6; "Slow down ramp uses deceleration
+//!   defined in PROFILE_DECELERATION, while Quick stop ramp uses
+//!   LIM_DECELERATION_MAX" (0x300A sub 2) for 0x605A and 0x605D.
+//! - Transition 15 (15.1.1): "Nach dem Verlassen des Fehlerzustands wird
+//!   der Befehl Fault reset im ControlWord vom Steuergerät gelöscht".
+//! - Target reached (15.1.2.1) "benötigt ein konfiguriertes
+//!   Positionsfenster und eine konfigurierte Zeit": the window is 0x21F1,
+//!   the time [`POSITION_WINDOW_TIME`](super::POSITION_WINDOW_TIME).
+//! - A following error (15.5 0x6065) is error 0x7387 (Fault), a profile
+//!   with a zero value is 0x7391 ("they should all have positive
+//!   values"), enabling outside the position limits 0x3007 in a position
+//!   mode is an error (15.4); every error is "power stage shutdown".
 
 use std::time::Duration;
 
 use eds2rust_drivers::zimmer_acs::errors::{ZimmerErrors, ZimmerErrorsCode};
 use eds2rust_drivers::zimmer_acs::od;
 use eds2rust_runtime::cia402::{
-    Controlword, DeviceConfig as MachineConfig, DeviceEvent, DeviceStateMachine, ModeOfOperation,
-    State,
+    Controlword, DeviceConfig as MachineConfig, DeviceEvent, ModeOfOperation, State,
 };
 
 use super::factory::{self, RAMP_MAX};
 use super::{POSITION_WINDOW_TIME, STO_LATCH_TIME, ZimmerAcs, ZimmerAcsEvent};
 use crate::Context;
+use crate::cia402::axis::{Axis, Drive, Step};
 use crate::cia402::profiler::{Goal, Profiler};
 
 type Ctx<'a, 'b> = &'a mut Context<'b, ZimmerAcsEvent>;
@@ -47,9 +69,7 @@ impl ZimmerAcs {
     /// values where nothing was saved, the volatile entries at 0. The
     /// carriage stays where it is.
     pub(super) fn power_on(&mut self, ctx: Ctx<'_, '_>) {
-        self.sm = None;
-        self.last = None;
-        self.stop_motion();
+        self.axis.power_off();
         self.angle_determined = false;
         self.clamp_released = false;
         self.sto_latched = false;
@@ -64,12 +84,10 @@ impl ZimmerAcs {
     /// Before handling an input: the state machine exists, the mechanics
     /// are at `ctx.now()`.
     pub(super) fn begin(&mut self, ctx: Ctx<'_, '_>) {
-        if self.sm.is_none() {
+        if self.axis.sm.is_none() {
             let mode = ctx.get::<od::ModesOfOperation>().map_or(1, |v| v.0);
-            let mut sm = DeviceStateMachine::new(ctx.now(), machine_config());
-            sm.set_mode(ModeOfOperation::from_i8(mode));
-            self.sm = Some(sm);
-            self.last = Some(ctx.now());
+            let mode = ModeOfOperation::from_i8(mode);
+            self.axis.switch_on(ctx.now(), machine_config(), mode);
         }
         self.advance(ctx);
     }
@@ -80,12 +98,7 @@ impl ZimmerAcs {
         // Effects can raise faults, which are events again; a few rounds
         // settle every chain.
         for _ in 0..8 {
-            let mut events = Vec::new();
-            if let Some(sm) = self.sm.as_mut() {
-                while let Some(event) = sm.poll_event() {
-                    events.push(event);
-                }
-            }
+            let events = self.axis.poll_events();
             // 15.4 0x3280: the power stage is asked for while STO is active.
             let sto_fault = !self.sto_ok() && self.power_requested();
             if events.is_empty() && !sto_fault {
@@ -132,37 +145,21 @@ impl ZimmerAcs {
     }
 
     fn mode(&self) -> ModeOfOperation {
-        self.sm
-            .as_ref()
-            .map_or(ModeOfOperation::NoMode, DeviceStateMachine::mode)
-    }
-
-    fn stop_motion(&mut self) {
-        self.profiler = Profiler::at(self.actual);
-        self.goal = self.actual;
-        self.queued = None;
-        self.pending = None;
-        self.moving = false;
-        self.outside_since = None;
-        self.inside_since = None;
+        self.axis.mode()
     }
 
     /// Raises `error` (15.4): 0x603F, Fault, EMCY with the error ID.
     pub(super) fn fault(&mut self, ctx: Ctx<'_, '_>, error: ZimmerErrors) {
         let code = u16::try_from(error.code()).unwrap_or(u16::MAX);
-        let now = ctx.now();
-        let Some(sm) = self.sm.as_mut() else {
-            return;
-        };
-        if sm.state().is_fault() && sm.fault_code() == Some(code) {
-            return;
-        }
-        if error == ZimmerErrors::StoAbnormalFault {
+        let persists = error == ZimmerErrors::StoAbnormalFault;
+        if persists && let Some(sm) = self.axis.sm.as_mut() {
             // 16.1.3: latched until the next power-on.
             sm.set_fault_persists(true);
         }
+        if !self.axis.raise_fault(ctx.now(), code) {
+            return;
+        }
         ctx.set::<od::ErrorCode>(ZimmerErrorsCode::from_kind(error));
-        sm.raise_fault(now, code);
         ctx.emcy(code, [0; 5]);
         ctx.emit(ZimmerAcsEvent::Fault(error));
     }
@@ -170,45 +167,34 @@ impl ZimmerAcs {
     pub(super) fn apply_controlword(&mut self, ctx: Ctx<'_, '_>) {
         let cw = ctx.get::<od::Controlword>().map_or(0, |v| v.0);
         let now = ctx.now();
-        if let Some(sm) = self.sm.as_mut() {
+        if let Some(sm) = self.axis.sm.as_mut() {
             sm.apply_controlword(now, Controlword(cw));
         }
     }
 
     pub(super) fn apply_mode(&mut self, ctx: Ctx<'_, '_>) {
         let mode = ctx.get::<od::ModesOfOperation>().map_or(1, |v| v.0);
-        if let Some(sm) = self.sm.as_mut() {
+        if let Some(sm) = self.axis.sm.as_mut() {
             sm.set_mode(ModeOfOperation::from_i8(mode));
         }
         self.stop_motion();
     }
 
     fn on_event(&mut self, ctx: Ctx<'_, '_>, event: DeviceEvent) {
-        match event {
-            DeviceEvent::Transition { number, from, to } => {
-                ctx.emit(ZimmerAcsEvent::StateChanged {
-                    transition: number,
-                    from,
-                    to,
-                });
-                self.on_transition(ctx, number, to);
-            }
-            // Taken at the next step, when an RPDO has written the target
-            // mapped after the controlword too.
-            DeviceEvent::NewSetPoint {
-                immediate,
-                relative,
-            } if self.mode() == ModeOfOperation::ProfilePosition => {
-                self.pending = Some((immediate, relative));
-            }
-            DeviceEvent::HomingStarted => {}
-            _ => {}
+        // 11.1.2: no homing mode (0x6060 refuses 6), so no homing starts.
+        if let Some(Step::Transition { number, from, to }) = self.axis.take_event(event) {
+            ctx.emit(ZimmerAcsEvent::StateChanged {
+                transition: number,
+                from,
+                to,
+            });
+            self.on_transition(ctx, number, to);
         }
     }
 
     fn on_transition(&mut self, ctx: Ctx<'_, '_>, number: u8, to: State) {
         let now = ctx.now();
-        if let Some(sm) = self.sm.as_mut() {
+        if let Some(sm) = self.axis.sm.as_mut() {
             // Set again by the monitor after the window time.
             sm.set_target_reached(false);
         }
@@ -217,7 +203,9 @@ impl ZimmerAcs {
                 self.angle_determined = true;
                 self.stop_motion();
                 let (min, max) = self.position_limits(ctx);
-                if is_position_mode(self.mode()) && (self.actual < min || self.actual > max) {
+                if is_position_mode(self.mode())
+                    && (self.axis.actual < min || self.axis.actual > max)
+                {
                     self.fault(ctx, ZimmerErrors::PositionOutOfLimitsInPositionMode);
                 }
             }
@@ -225,7 +213,7 @@ impl ZimmerAcs {
                 let code = ctx.get::<od::QuickStopOptionCode>().map_or(2, |v| v.0);
                 if code == od::QuickStopOptionCodeValue::DISABLE_POWER_STAGE.0 {
                     self.stop_motion();
-                    if let Some(sm) = self.sm.as_mut() {
+                    if let Some(sm) = self.axis.sm.as_mut() {
                         sm.complete_quick_stop(now);
                     }
                 }
@@ -238,9 +226,8 @@ impl ZimmerAcs {
             ctx.emcy(0, [0; 5]);
             let cw = ctx.get::<od::Controlword>().map_or(0, |v| v.0) & !0x0080;
             ctx.set::<od::Controlword>(od::ControlwordValue(cw));
-            if let Some(sm) = self.sm.as_mut() {
-                sm.set_position_following_error(false);
-                sm.set_internal_limit(false);
+            self.axis.clear_fault_bits();
+            if let Some(sm) = self.axis.sm.as_mut() {
                 sm.apply_controlword(now, Controlword(cw));
             }
         }
@@ -305,128 +292,21 @@ impl ZimmerAcs {
         f64::from(mm.max(1)) * UM_PER_MM
     }
 
-    /// Runs the mechanics from the last input to `ctx.now()`.
+    /// Runs the mechanics from the last input to `ctx.now()`; the carriage
+    /// follows the demand only when it can move (power stage, clamp).
     fn advance(&mut self, ctx: Ctx<'_, '_>) {
-        let now = ctx.now();
-        let elapsed = self
-            .last
-            .map_or(Duration::ZERO, |last| now.saturating_duration_since(last));
-        self.last = Some(now);
-        let seconds = elapsed.as_secs_f64() * self.time_scale;
-        match self.state() {
-            Some(State::OperationEnabled) => self.run_enabled(ctx, seconds),
-            Some(State::QuickStopActive) => {
-                let code = ctx.get::<od::QuickStopOptionCode>().map_or(2, |v| v.0);
-                let quick = matches!(code, 2 | 6);
-                let goal = Goal::Stop {
-                    deceleration: self.ramp(ctx, quick),
-                };
-                // 15.5: options 0..2 disable the drive after the ramp (12),
-                // 5 and 6 stay in Quick stop active.
-                if self.profiler.run(seconds, goal)
-                    && matches!(code, 0..=2)
-                    && let Some(sm) = self.sm.as_mut()
-                {
-                    sm.complete_quick_stop(now);
-                }
-            }
-            _ => self.stop_motion(),
-        }
+        self.run_mechanics(ctx);
         if self.movable() {
-            self.actual = self.profiler.position;
-        }
-    }
-
-    fn run_enabled(&mut self, ctx: Ctx<'_, '_>, seconds: f64) {
-        let mode = self.mode();
-        if mode == ModeOfOperation::CyclicSynchronousPosition {
-            // The axis takes each target at once; no interpolation between
-            // set-points is modelled.
-            let raw = ctx.get::<od::TargetPosition>().map_or(0, |v| v.0);
-            let (min, max) = self.position_limits(ctx);
-            let target = f64::from(raw).max(min).min(max);
-            if let Some(sm) = self.sm.as_mut() {
-                sm.set_internal_limit(target != f64::from(raw));
-            }
-            self.profiler = Profiler::at(target);
-            self.goal = target;
-            return;
-        }
-        if mode != ModeOfOperation::ProfilePosition {
-            return;
-        }
-        let halt = self.sm.as_ref().is_some_and(|sm| sm.controlword().halt());
-        let goal = if halt {
-            let code = ctx.get::<od::HaltOptionCode>().map_or(1, |v| v.0);
-            Goal::Stop {
-                deceleration: self.ramp(ctx, code == 2),
-            }
-        } else {
-            match self.profile(ctx) {
-                Some((velocity, acceleration, deceleration)) => Goal::Target {
-                    target: self.goal,
-                    velocity,
-                    acceleration,
-                    deceleration,
-                },
-                None => Goal::Stop {
-                    deceleration: self.ramp(ctx, true),
-                },
-            }
-        };
-        if self.profiler.run(seconds, goal)
-            && !halt
-            && let Some(next) = self.queued.take()
-        {
-            self.start_motion(ctx, next);
+            self.axis.actual = self.axis.profiler.position;
         }
     }
 
     fn start_motion(&mut self, ctx: Ctx<'_, '_>, target: f64) {
         ctx.emit(ZimmerAcsEvent::MotionStarted {
-            from_um: self.actual.round() as i32,
+            from_um: self.axis.actual.round() as i32,
             to_um: target.round() as i32,
         });
-        self.goal = target;
-        self.moving = true;
-        self.inside_since = None;
-    }
-
-    /// A new set-point (15.1.1 bits 4-6): the target, its limits, the
-    /// profile, then now (bit 5 or at rest) or after the running move.
-    fn start_set_point(&mut self, ctx: Ctx<'_, '_>, immediate: bool, relative: bool) {
-        let raw = f64::from(ctx.get::<od::TargetPosition>().map_or(0, |v| v.0));
-        let reference = self.queued.unwrap_or(self.goal);
-        let requested = if relative { reference + raw } else { raw };
-        let (min, max) = self.position_limits(ctx);
-        let target = requested.max(min).min(max);
-        let limited = target != requested;
-        if let Some(sm) = self.sm.as_mut() {
-            sm.set_internal_limit(limited);
-        }
-        if limited {
-            ctx.emit(ZimmerAcsEvent::TargetLimited {
-                requested_um: requested.round() as i64,
-                limited_um: target.round() as i32,
-            });
-        }
-        if self.profile(ctx).is_none() {
-            self.fault(ctx, ZimmerErrors::ProfilerParametersNotValid);
-            return;
-        }
-        ctx.emit(ZimmerAcsEvent::SetPointAccepted {
-            target_um: target.round() as i32,
-            relative,
-            immediate,
-        });
-        let busy = !self.profiler.at_rest() || self.profiler.position != self.goal;
-        if immediate || !busy {
-            self.queued = None;
-            self.start_motion(ctx, target);
-        } else {
-            self.queued = Some(target);
-        }
-        self.inside_since = None;
+        self.axis.start_motion(target);
     }
 
     /// The periodic part: STO latch, deferred set-point, following error,
@@ -441,74 +321,7 @@ impl ZimmerAcs {
             ctx.emit(ZimmerAcsEvent::StoLatched);
             self.fault(ctx, ZimmerErrors::StoAbnormalFault);
         }
-        let enabled = self.state() == Some(State::OperationEnabled);
-        if let Some((immediate, relative)) = self.pending.take()
-            && enabled
-        {
-            self.start_set_point(ctx, immediate, relative);
-        }
-        self.check_following_error(ctx);
-        self.update_target_reached(ctx);
-    }
-
-    /// 15.5 0x6065/0x6066: outside the window for longer than the timeout
-    /// is a following error (bit 13, error 0x7387). 0xFFFFFFFF switches
-    /// the monitor off (CiA 402).
-    fn check_following_error(&mut self, ctx: Ctx<'_, '_>) {
-        let now = ctx.now();
-        if self.state() != Some(State::OperationEnabled) || !is_position_mode(self.mode()) {
-            self.outside_since = None;
-            return;
-        }
-        let window = ctx
-            .get::<od::FollowingErrorWindow>()
-            .map_or(u32::MAX, |v| v.0);
-        let error = (self.profiler.position - self.actual).abs();
-        if window == u32::MAX || error <= f64::from(window) {
-            self.outside_since = None;
-            return;
-        }
-        let since = *self.outside_since.get_or_insert(now);
-        let timeout = ctx.get::<od::FollowingErrorTimeOut>().map_or(0, |v| v.0);
-        if now.saturating_duration_since(since) > Duration::from_millis(u64::from(timeout)) {
-            if let Some(sm) = self.sm.as_mut() {
-                sm.set_position_following_error(true);
-            }
-            self.fault(ctx, ZimmerErrors::PositionFollowingError);
-        }
-    }
-
-    /// 15.1.2.1: target reached once the position stays within 0x21F1 of
-    /// the target for the window time; while halted it means standstill
-    /// (CiA 402).
-    fn update_target_reached(&mut self, ctx: Ctx<'_, '_>) {
-        let now = ctx.now();
-        let pp = self.state() == Some(State::OperationEnabled)
-            && self.mode() == ModeOfOperation::ProfilePosition;
-        let halt = self.sm.as_ref().is_some_and(|sm| sm.controlword().halt());
-        let window = f64::from(ctx.get::<od::PositionWindowX21F1>().map_or(0, |v| v.0));
-        let settled = self.profiler.at_rest()
-            && self.pending.is_none()
-            && (halt
-                || (self.profiler.position == self.goal
-                    && self.queued.is_none()
-                    && (self.goal - self.actual).abs() <= window));
-        let reached = if pp && settled {
-            let since = *self.inside_since.get_or_insert(now);
-            now.saturating_duration_since(since) >= POSITION_WINDOW_TIME
-        } else {
-            self.inside_since = None;
-            false
-        };
-        if let Some(sm) = self.sm.as_mut() {
-            sm.set_target_reached(reached);
-        }
-        if reached && self.moving && !halt {
-            self.moving = false;
-            ctx.emit(ZimmerAcsEvent::TargetReached {
-                position_um: self.actual.round() as i32,
-            });
-        }
+        self.monitor_motion(ctx);
     }
 
     /// 11.6: the clamping element follows the state machine unless 0x2129
@@ -533,7 +346,7 @@ impl ZimmerAcs {
 
     /// Writes the statusword and the actual values into the table.
     fn publish(&mut self, ctx: Ctx<'_, '_>) {
-        let Some(sm) = self.sm.as_ref() else {
+        let Some(sm) = self.axis.sm.as_ref() else {
             return;
         };
         let sw = od::StatuswordValue(sm.statusword().0 & !(1 << 9))
@@ -542,11 +355,11 @@ impl ZimmerAcs {
         let mode = sm.mode().as_i8();
         ctx.set::<od::Statusword>(sw);
         ctx.set::<od::ModesOfOperationDisplay>(od::ModesOfOperationDisplayValue(mode));
-        ctx.set::<od::PositionActualValue>(
-            od::PositionActualValueValue(self.actual.round() as i32),
-        );
+        ctx.set::<od::PositionActualValue>(od::PositionActualValueValue(
+            self.axis.actual.round() as i32
+        ));
         let velocity = if self.movable() {
-            self.profiler.velocity
+            self.axis.profiler.velocity
         } else {
             0.0
         };
@@ -554,7 +367,7 @@ impl ZimmerAcs {
             (velocity / UM_PER_MM).round() as i32,
         ));
         ctx.set::<od::FollowingErrorActualValue>(od::FollowingErrorActualValueValue(
-            (self.profiler.position - self.actual).round() as i32,
+            (self.axis.profiler.position - self.axis.actual).round() as i32,
         ));
         // 16.1.3 and 15.5 0x251A; the STO supply is always fine here.
         let (sto1, sto2) = (self.sto1, self.sto2);
@@ -571,5 +384,159 @@ impl ZimmerAcs {
                 .with_sto_abnormal_fault(sto1 != sto2 || self.sto_latched)
                 .with_sto_report(report),
         );
+    }
+}
+
+impl Drive for ZimmerAcs {
+    type Event = ZimmerAcsEvent;
+
+    fn axis(&mut self) -> &mut Axis {
+        &mut self.axis
+    }
+
+    fn quick_stop(&mut self, ctx: Ctx<'_, '_>) -> (f64, bool) {
+        let code = ctx.get::<od::QuickStopOptionCode>().map_or(2, |v| v.0);
+        // 15.5: options 0..2 disable the drive after the ramp (12), 5 and
+        // 6 stay in Quick stop active; 2 and 6 brake on the quick stop ramp.
+        (
+            self.ramp(ctx, matches!(code, 2 | 6)),
+            !matches!(code, 0..=2),
+        )
+    }
+
+    fn stop_motion(&mut self) {
+        self.axis.stop_motion();
+    }
+
+    fn run_enabled(&mut self, ctx: Ctx<'_, '_>, seconds: f64) {
+        let mode = self.mode();
+        if mode == ModeOfOperation::CyclicSynchronousPosition {
+            // The axis takes each target at once; no interpolation between
+            // set-points is modelled.
+            let raw = ctx.get::<od::TargetPosition>().map_or(0, |v| v.0);
+            let (min, max) = self.position_limits(ctx);
+            let target = f64::from(raw).max(min).min(max);
+            if let Some(sm) = self.axis.sm.as_mut() {
+                sm.set_internal_limit(target != f64::from(raw));
+            }
+            self.axis.profiler = Profiler::at(target);
+            self.axis.goal = target;
+            return;
+        }
+        if mode != ModeOfOperation::ProfilePosition {
+            return;
+        }
+        let halt = self.axis.halted();
+        let goal = if halt {
+            let code = ctx.get::<od::HaltOptionCode>().map_or(1, |v| v.0);
+            Goal::Stop {
+                deceleration: self.ramp(ctx, code == 2),
+            }
+        } else {
+            match self.profile(ctx) {
+                Some((velocity, acceleration, deceleration)) => Goal::Target {
+                    target: self.axis.goal,
+                    velocity,
+                    acceleration,
+                    deceleration,
+                },
+                None => Goal::Stop {
+                    deceleration: self.ramp(ctx, true),
+                },
+            }
+        };
+        if self.axis.profiler.run(seconds, goal)
+            && !halt
+            && let Some(next) = self.axis.queued.take()
+        {
+            self.start_motion(ctx, next);
+        }
+    }
+
+    /// A new set-point (15.1.1 bits 4-6): the target, its limits, the
+    /// profile, then now (bit 5 or at rest) or after the running move.
+    fn start_set_point(&mut self, ctx: Ctx<'_, '_>, immediate: bool, relative: bool) {
+        let raw = f64::from(ctx.get::<od::TargetPosition>().map_or(0, |v| v.0));
+        let reference = self.axis.queued.unwrap_or(self.axis.goal);
+        let requested = if relative { reference + raw } else { raw };
+        let (min, max) = self.position_limits(ctx);
+        let target = requested.max(min).min(max);
+        let limited = target != requested;
+        if let Some(sm) = self.axis.sm.as_mut() {
+            sm.set_internal_limit(limited);
+        }
+        if limited {
+            ctx.emit(ZimmerAcsEvent::TargetLimited {
+                requested_um: requested.round() as i64,
+                limited_um: target.round() as i32,
+            });
+        }
+        if self.profile(ctx).is_none() {
+            self.fault(ctx, ZimmerErrors::ProfilerParametersNotValid);
+            return;
+        }
+        ctx.emit(ZimmerAcsEvent::SetPointAccepted {
+            target_um: target.round() as i32,
+            relative,
+            immediate,
+        });
+        if self.axis.take_set_point(target, immediate) {
+            self.start_motion(ctx, target);
+        }
+        self.axis.inside_since = None;
+    }
+
+    /// 15.5 0x6065/0x6066: outside the window for longer than the timeout
+    /// is a following error (bit 13, error 0x7387). 0xFFFFFFFF switches
+    /// the monitor off (CiA 402).
+    fn check_following_error(&mut self, ctx: Ctx<'_, '_>) {
+        let now = ctx.now();
+        if self.state() != Some(State::OperationEnabled) || !is_position_mode(self.mode()) {
+            self.axis.outside_since = None;
+            return;
+        }
+        let window = ctx
+            .get::<od::FollowingErrorWindow>()
+            .map_or(u32::MAX, |v| v.0);
+        let error = (self.axis.profiler.position - self.axis.actual).abs();
+        if window == u32::MAX || error <= f64::from(window) {
+            self.axis.outside_since = None;
+            return;
+        }
+        let since = *self.axis.outside_since.get_or_insert(now);
+        let timeout = ctx.get::<od::FollowingErrorTimeOut>().map_or(0, |v| v.0);
+        if now.saturating_duration_since(since) > Duration::from_millis(u64::from(timeout)) {
+            if let Some(sm) = self.axis.sm.as_mut() {
+                sm.set_position_following_error(true);
+            }
+            self.fault(ctx, ZimmerErrors::PositionFollowingError);
+        }
+    }
+
+    /// 15.1.2.1: target reached once the position stays within 0x21F1 of
+    /// the target for the window time; while halted it means standstill
+    /// (CiA 402).
+    fn update_target_reached(&mut self, ctx: Ctx<'_, '_>) {
+        let now = ctx.now();
+        let pp = self.state() == Some(State::OperationEnabled)
+            && self.mode() == ModeOfOperation::ProfilePosition;
+        let halt = self.axis.halted();
+        let window = f64::from(ctx.get::<od::PositionWindowX21F1>().map_or(0, |v| v.0));
+        let reached = if pp && self.axis.settled(halt, window) {
+            let since = *self.axis.inside_since.get_or_insert(now);
+            now.saturating_duration_since(since) >= POSITION_WINDOW_TIME
+        } else {
+            self.axis.inside_since = None;
+            false
+        };
+        if let Some(sm) = self.axis.sm.as_mut() {
+            sm.set_target_reached(reached);
+        }
+        if reached && self.axis.moving && !halt {
+            self.axis.moving = false;
+            ctx.emit(ZimmerAcsEvent::TargetReached {
+                position_um: self.axis.actual.round() as i32,
+            });
+        }
     }
 }

@@ -21,6 +21,16 @@ pub fn seed(name: &str) -> Arc<eds2rust::ir::Device> {
     Arc::new(loaded.device.expect("a device"))
 }
 
+/// A decoder that knows the nodes `nodes` by `eds/<name>.yaml`.
+pub fn seed_decoder(name: &str, nodes: &[u8]) -> Decoder {
+    let device = seed(name);
+    let mut decoder = Decoder::new();
+    for node in nodes {
+        decoder.add_node(*node, device.clone());
+    }
+    decoder
+}
+
 /// Every record of `trace` (one frame a line) as JSON.
 pub fn decode(decoder: &mut Decoder, trace: &[String]) -> Vec<Json> {
     let text = trace.join("\n");
@@ -34,6 +44,14 @@ pub fn decode(decoder: &mut Decoder, trace: &[String]) -> Vec<Json> {
         (read.frames, read.bad_lines, read.skipped),
         (trace.len(), 0, 0)
     );
+    records
+}
+
+/// Every record of `trace` decoded with `eds/<name>.yaml` at `nodes`,
+/// each a valid frame ([`assert_every_frame_decodes`]).
+pub fn decode_seed(name: &str, nodes: &[u8], trace: &[String]) -> Vec<Json> {
+    let records = decode(&mut seed_decoder(name, nodes), trace);
+    assert_every_frame_decodes(&records);
     records
 }
 
