@@ -21,6 +21,7 @@
 pub mod bounded;
 pub mod build;
 pub mod diag;
+#[cfg(feature = "diff")]
 pub mod diff;
 #[cfg(feature = "json")]
 pub mod dump;
@@ -28,9 +29,11 @@ pub mod eds;
 pub mod r#gen;
 pub mod input;
 pub mod ir;
+#[cfg(feature = "network")]
 pub mod network;
 pub mod profiles;
 pub mod read;
+#[cfg(feature = "yaml")]
 pub mod table;
 pub mod text;
 

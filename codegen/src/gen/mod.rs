@@ -6,9 +6,11 @@
 //! - [`apply_variant`]: the device as one of its product [`Variant`](crate::ir::Variant)s,
 //!   for any generator.
 
+#[cfg(feature = "export")]
 pub mod eds;
 pub mod rust;
 
+#[cfg(feature = "export")]
 pub use eds::{to_eds, to_eds_variant};
 
 use core::fmt;
