@@ -100,14 +100,19 @@ fn median(mut values: Vec<f64>) -> f64 {
 
 /// One unit of `cargo build --timings`.
 struct Unit {
+    /// Its number in the report.
+    id: u64,
     name: String,
     target: String,
     start: f64,
     duration: f64,
-    /// When its metadata was ready (dependents may start then).
+    /// When its front end was done (its metadata ready: dependents that
+    /// need only that may start), from its start.
     rmeta: Option<f64>,
-    unlocks: Vec<usize>,
-    unlocks_rmeta: Vec<usize>,
+    /// The units that could start when it finished (it was the last of
+    /// their dependencies), and when its metadata was ready.
+    unblocks: Vec<u64>,
+    unblocks_rmeta: Vec<u64>,
 }
 
 /// The units of the last timings report in `target`.
@@ -119,60 +124,63 @@ fn timings(target: &Path) -> Option<Vec<Unit>> {
         .split(";\n")
         .next()?;
     let units: serde_json::Value = serde_json::from_str(data).ok()?;
-    let list = |v: &serde_json::Value| -> Vec<usize> {
+    let list = |v: &serde_json::Value| -> Vec<u64> {
         v.as_array()
-            .map(|a| {
-                a.iter()
-                    .filter_map(|i| i.as_u64())
-                    .map(|i| i as usize)
-                    .collect()
-            })
+            .map(|a| a.iter().filter_map(|i| i.as_u64()).collect())
             .unwrap_or_default()
+    };
+    // `sections`: [["frontend", {"start": …, "end": …}], ["codegen", …]].
+    let frontend_end = |v: &serde_json::Value| -> Option<f64> {
+        v.as_array()?
+            .iter()
+            .find(|s| s[0] == "frontend")
+            .and_then(|s| s[1]["end"].as_f64())
     };
     units
         .as_array()?
         .iter()
         .map(|u| {
             Some(Unit {
+                id: u["i"].as_u64()?,
                 name: u["name"].as_str()?.to_string(),
                 target: u["target"].as_str().unwrap_or("").trim().to_string(),
                 start: u["start"].as_f64()?,
                 duration: u["duration"].as_f64()?,
-                rmeta: u["rmeta_time"].as_f64(),
-                unlocks: list(&u["unlocked_units"]),
-                unlocks_rmeta: list(&u["unlocked_rmeta_units"]),
+                rmeta: frontend_end(&u["sections"]),
+                unblocks: list(&u["unblocked_units"]),
+                unblocks_rmeta: list(&u["unblocked_rmeta_units"]),
             })
         })
         .collect()
 }
 
 /// The chain of units that ends last: from the last unit to finish, back
-/// through the dependency whose completion (or metadata) let it start last.
+/// through the dependency whose completion (or metadata) let it start.
 fn critical_path(units: &[Unit]) -> Vec<&Unit> {
     let end = |u: &Unit| u.start + u.duration;
-    let Some(mut at) = (0..units.len()).max_by(|&a, &b| end(&units[a]).total_cmp(&end(&units[b])))
-    else {
+    let Some(mut at) = units.iter().max_by(|a, b| end(a).total_cmp(&end(b))) else {
         return Vec::new();
     };
-    let mut path = vec![&units[at]];
-    loop {
-        // Whatever unlocked `at`, and when it did.
-        let unlocked_by = units.iter().enumerate().filter_map(|(i, u)| {
-            if u.unlocks.contains(&at) {
-                Some((i, end(u)))
-            } else if u.unlocks_rmeta.contains(&at) {
-                Some((i, u.start + u.rmeta.unwrap_or(u.duration)))
+    let mut path = vec![at];
+    // The unit that unblocked `at`, and when it did.
+    while let Some((by, _)) = units
+        .iter()
+        .filter_map(|u| {
+            if u.unblocks.contains(&at.id) {
+                Some((u, end(u)))
+            } else if u.unblocks_rmeta.contains(&at.id) {
+                Some((u, u.start + u.rmeta.unwrap_or(u.duration)))
             } else {
                 None
             }
-        });
-        match unlocked_by.max_by(|a, b| a.1.total_cmp(&b.1)) {
-            Some((i, _)) => {
-                at = i;
-                path.push(&units[at]);
-            }
-            None => break,
+        })
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+    {
+        if path.len() > units.len() {
+            break; // a report that loops: print what there is
         }
+        at = by;
+        path.push(at);
     }
     path.reverse();
     path
