@@ -14,9 +14,9 @@ use crate::r#gen::rust::Options;
 
 /// Generates the Rust of CANopen devices from a build script: one
 /// `<OUT_DIR>/<name>.rs` per [`device`](Builder::device), for `include!`;
-/// and per [`network`](Builder::network) one `<OUT_DIR>/<name>.rs` with a
-/// module per node and the `network` module (its node files beside it in
-/// `<OUT_DIR>/<name>/`).
+/// and per `network` (`Builder::network`, feature `network`) one
+/// `<OUT_DIR>/<name>.rs` with a module per node and the `network` module
+/// (its node files beside it in `<OUT_DIR>/<name>/`).
 ///
 /// Every problem is reported when [`generate`](Builder::generate) (or
 /// [`build`](Builder::build)) runs, never by a panic: all diagnostics of all

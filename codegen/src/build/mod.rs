@@ -64,7 +64,7 @@ pub struct Generated {
 }
 
 /// Reads `input` (EDS/DCF or YAML table), applies the YAML `overlays` in
-/// order ([`crate::table::apply_overlay`]) and generates its Rust source.
+/// order (`table::apply_overlay`) and generates its Rust source.
 ///
 /// The `Err` holds every diagnostic found; with `options.strict` warnings are
 /// errors. Use [`generate_device`] to get the warnings of a success and the
