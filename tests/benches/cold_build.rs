@@ -93,9 +93,15 @@ fn cold_build(crate_dir: &Path, args: &[&str], target: &Path, jobs: Option<&str>
     Sample { wall, cpu }
 }
 
+/// The median (the mean of the middle two of an even count).
 fn median(mut values: Vec<f64>) -> f64 {
     values.sort_by(f64::total_cmp);
-    values[values.len() / 2]
+    let n = values.len();
+    if n % 2 == 0 {
+        (values[n / 2 - 1] + values[n / 2]) / 2.0
+    } else {
+        values[n / 2]
+    }
 }
 
 /// One unit of `cargo build --timings`.
