@@ -97,7 +97,7 @@ fn cold_build(crate_dir: &Path, args: &[&str], target: &Path, jobs: Option<&str>
 fn median(mut values: Vec<f64>) -> f64 {
     values.sort_by(f64::total_cmp);
     let n = values.len();
-    if n % 2 == 0 {
+    if n.is_multiple_of(2) {
         (values[n / 2 - 1] + values[n / 2]) / 2.0
     } else {
         values[n / 2]
