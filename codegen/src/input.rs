@@ -40,6 +40,34 @@ pub fn read_device(path: &Path, options: &Options) -> Loaded {
 pub(crate) fn read_unfinished(path: &Path, options: &Options) -> Loaded {
     match InputKind::of(path) {
         InputKind::Eds => crate::eds::read_file_unfinished(path, options),
+        #[cfg(feature = "yaml")]
         InputKind::Table => crate::table::read_file_unfinished(path, options),
+        #[cfg(not(feature = "yaml"))]
+        InputKind::Table => yaml_off(path, "a YAML object table"),
+    }
+}
+
+/// The error for a YAML input (`what`: "a YAML object table", "an
+/// overlay") when the crate is built without its `yaml` feature.
+#[cfg(not(feature = "yaml"))]
+pub(crate) fn yaml_off(path: &Path, what: &str) -> Loaded {
+    use crate::diag::{Diagnostic, Diagnostics, Levels, Location, Severity};
+    let mut diagnostics = Diagnostics::new();
+    diagnostics.push(Diagnostic {
+        severity: Severity::Error,
+        code: "input::feature-off",
+        file: path.display().to_string(),
+        location: Location::default(),
+        message: format!(
+            "{what} cannot be read: eds2rust is built without its `yaml` feature \
+             (on by default; `default-features = false` turns it off)"
+        ),
+        notes: Vec::new(),
+    });
+    Loaded {
+        device: None,
+        diagnostics,
+        files: vec![path.to_path_buf()],
+        levels: Levels::new(),
     }
 }

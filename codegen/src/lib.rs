@@ -5,22 +5,32 @@
 //!
 //! Pipeline (one stage per module):
 //! - [`eds`]: EDS/DCF text (CiA 306) → [`ir::Device`], with diagnostics;
-//! - [`table`]: YAML object tables (whole devices and overlays on an EDS) → [`ir::Device`];
+//! - `table` (feature `yaml`): YAML object tables (whole devices and overlays on an EDS) → [`ir::Device`];
 //! - [`read`]: what both readers share (options, the result of reading);
 //! - [`input`]: either of the two, chosen by file extension;
 //! - [`ir`]: the object-dictionary model, plain data;
 //! - `dump` (feature `json`): IR → JSON for tools and tests;
-//! - `gen` (`r#gen`: `gen` is a reserved word in Rust 2024): IR → files: an EDS (CiA 306) export, product variants applied;
-//! - [`diff`]: a semantic diff of two devices, each change classified
-//!   breaking, additive or compatible (`eds2rust diff`);
+//! - `gen` (`r#gen`: `gen` is a reserved word in Rust 2024): IR → files: Rust,
+//!   an EDS (CiA 306) export (feature `export`), product variants applied;
+//! - `network` (feature `network`): bus files read, configured, generated;
+//! - `diff` (feature `diff`): a semantic diff of two devices, each change
+//!   classified breaking, additive or compatible (`eds2rust diff`);
 //! - [`diag`]: diagnostics with file, line, section and key;
 //! - [`build`]: the build-script API ([`Builder`], in the shape of
 //!   prost-build) and the pure [`generate`]: input + overlays → Rust source.
+//!
+//! Features: the default ones (`yaml`, `network`) are what [`Builder`]
+//! needs; a build script that reads only EDS/DCF files may turn them off
+//! (`default-features = false`: no serde, no YAML reader). What only the
+//! command line uses is opt-in: `serde`, `json`, `diff`, `api`, `export`,
+//! `network-check`, and `cli` for all of them (Cargo.toml says what each
+//! adds; docs/build-api.md, "Features").
 #![forbid(unsafe_code)]
 
 pub mod bounded;
 pub mod build;
 pub mod diag;
+#[cfg(feature = "diff")]
 pub mod diff;
 #[cfg(feature = "json")]
 pub mod dump;
@@ -28,9 +38,11 @@ pub mod eds;
 pub mod r#gen;
 pub mod input;
 pub mod ir;
+#[cfg(feature = "network")]
 pub mod network;
 pub mod profiles;
 pub mod read;
+#[cfg(feature = "yaml")]
 pub mod table;
 pub mod text;
 

@@ -10,6 +10,7 @@
 use std::borrow::Cow;
 
 /// Where an input stops being UTF-8.
+#[cfg(feature = "yaml")]
 pub(crate) struct NotUtf8 {
     /// The 0-based offset of the first byte that is not UTF-8.
     pub byte: usize,
@@ -18,6 +19,7 @@ pub(crate) struct NotUtf8 {
 }
 
 /// An input's bytes as UTF-8 text without a leading byte-order mark.
+#[cfg(feature = "yaml")]
 pub(crate) fn decode_utf8(bytes: &[u8]) -> Result<&str, NotUtf8> {
     match std::str::from_utf8(bytes) {
         Ok(text) => Ok(text.strip_prefix('\u{feff}').unwrap_or(text)),

@@ -6,6 +6,7 @@ use std::path::{Path, PathBuf};
 
 use super::cargo::{cargo_lines, in_build_script, project_dir};
 use super::files::write_if_changed;
+#[cfg(feature = "network")]
 use super::network::generate_network;
 use super::{Error, error, generate_device_reading, push_unique};
 use crate::diag::{Diagnostics, Levels};
@@ -13,9 +14,9 @@ use crate::r#gen::rust::Options;
 
 /// Generates the Rust of CANopen devices from a build script: one
 /// `<OUT_DIR>/<name>.rs` per [`device`](Builder::device), for `include!`;
-/// and per [`network`](Builder::network) one `<OUT_DIR>/<name>.rs` with a
-/// module per node and the `network` module (its node files beside it in
-/// `<OUT_DIR>/<name>/`).
+/// and per `network` (`Builder::network`, feature `network`) one
+/// `<OUT_DIR>/<name>.rs` with a module per node and the `network` module
+/// (its node files beside it in `<OUT_DIR>/<name>/`).
 ///
 /// Every problem is reported when [`generate`](Builder::generate) (or
 /// [`build`](Builder::build)) runs, never by a panic: all diagnostics of all
@@ -23,6 +24,7 @@ use crate::r#gen::rust::Options;
 #[derive(Debug, Clone, Default)]
 pub struct Builder {
     devices: Vec<DeviceInput>,
+    #[cfg(feature = "network")]
     networks: Vec<NetworkInput>,
     /// Overlays given before any device.
     orphan_overlays: Vec<PathBuf>,
@@ -35,6 +37,7 @@ pub struct Builder {
     allow_base_dirs: Vec<PathBuf>,
 }
 
+#[cfg(feature = "network")]
 #[derive(Debug, Clone)]
 struct NetworkInput {
     name: String,
@@ -112,6 +115,7 @@ impl Builder {
     /// `name` follows the rules of a device name and is unique among both.
     ///
     /// [`device`]: Builder::device
+    #[cfg(feature = "network")]
     pub fn network(&mut self, name: &str, bus_file: impl AsRef<Path>) -> &mut Self {
         self.networks.push(NetworkInput {
             name: name.to_string(),
@@ -298,6 +302,7 @@ impl Builder {
                 Err(diagnostics) => all.extend(diagnostics),
             }
         }
+        #[cfg(feature = "network")]
         for network in &self.networks {
             if let Err(message) = check_name("network", &network.name) {
                 all.push(error("build::device-name", &network.bus_file, message));

@@ -34,6 +34,7 @@ mod builder;
 mod cargo;
 mod error;
 mod files;
+#[cfg(feature = "network")]
 mod network;
 
 use std::path::{Path, PathBuf};
@@ -48,6 +49,7 @@ pub use builder::{Builder, Report, WARNINGS_FILE};
 pub use cargo::{cargo_lines, error_lines, in_build_script, project_dir};
 pub use error::Error;
 pub use files::write_whole;
+#[cfg(feature = "network")]
 pub use network::{GeneratedNetwork, generate_bus, generate_network};
 
 /// What generating one device produced.
@@ -62,7 +64,7 @@ pub struct Generated {
 }
 
 /// Reads `input` (EDS/DCF or YAML table), applies the YAML `overlays` in
-/// order ([`crate::table::apply_overlay`]) and generates its Rust source.
+/// order (`table::apply_overlay`) and generates its Rust source.
 ///
 /// The `Err` holds every diagnostic found; with `options.strict` warnings are
 /// errors. Use [`generate_device`] to get the warnings of a success and the
@@ -175,6 +177,7 @@ pub fn load_device(input: &Path, overlays: &[PathBuf], options: &crate::read::Op
 /// files' `diagnostics:` levels, `read.levels` over them and `read.strict`
 /// apply to every diagnostic. The `Err` holds every diagnostic when there is
 /// an error.
+#[cfg(feature = "api")]
 pub fn api_listing_files(
     input: &Path,
     overlays: &[PathBuf],
@@ -242,7 +245,13 @@ fn load(input: &Path, overlays: &[PathBuf], read: &crate::read::Options) -> Load
             ));
             break;
         }
+        #[cfg(feature = "yaml")]
         let loaded = crate::table::apply_overlay_unfinished(base, overlay, read);
+        #[cfg(not(feature = "yaml"))]
+        let loaded = {
+            drop(base);
+            crate::input::yaml_off(overlay, "an overlay")
+        };
         push_unique(&mut files, loaded.files);
         diagnostics.extend(loaded.diagnostics);
         levels = levels.merged(&loaded.levels);

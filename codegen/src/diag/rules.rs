@@ -152,6 +152,10 @@ pub const RULES: &[Rule] = &[
         "a name, description or unit with control or bidirectional-text characters",
     ),
     rule(
+        "input::feature-off",
+        "an input this build cannot read: a YAML table without the `yaml` feature",
+    ),
+    rule(
         "input::not-a-file",
         "an input that is not a regular file (directory, FIFO, device, /proc)",
     ),

@@ -150,9 +150,8 @@ pub fn decode(file: &str, bytes: &[u8], diags: &mut Diagnostics) -> String {
         Ok(text) => text.to_string(),
         Err(err) => {
             // `decode` follows a UTF-16 byte-order mark, else reads Windows-1252.
-            let (text, encoding, _) = encoding_rs::WINDOWS_1252.decode(bytes);
-            let text = text.into_owned();
-            let (line, message) = if encoding == encoding_rs::WINDOWS_1252 {
+            let (text, encoding) = super::legacy::decode(bytes);
+            let (line, message) = if encoding == super::legacy::Encoding::Windows1252 {
                 let offset = err.valid_up_to();
                 let line = bytes[..offset].iter().filter(|&&b| b == b'\n').count() as u32 + 1;
                 let message = format!(

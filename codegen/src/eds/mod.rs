@@ -6,6 +6,7 @@
 mod check;
 mod entry;
 pub mod ini;
+mod legacy;
 mod lower;
 pub mod number;
 mod object;

@@ -1,21 +1,23 @@
 //! Generators: the IR ([`Device`]) → files.
 //!
-//! - [`eds`]: a CiA 306 EDS export ([`eds::to_eds`], [`eds::to_eds_variant`]);
+//! - `eds` (feature `export`): a CiA 306 EDS export (`eds::to_eds`, `eds::to_eds_variant`);
 //! - [`rust`]: typed Rust for a device (zero-sized entry types, value types,
 //!   PDO structs, error enums), formatted by prettyplease;
 //! - [`apply_variant`]: the device as one of its product [`Variant`](crate::ir::Variant)s,
 //!   for any generator.
 
+#[cfg(feature = "export")]
 pub mod eds;
 pub mod rust;
 
+#[cfg(feature = "export")]
 pub use eds::{to_eds, to_eds_variant};
 
 use core::fmt;
 
 use crate::ir::{Device, Literal, Origin, Value};
 
-/// Why [`apply_variant`] (and [`to_eds_variant`]) could not make a device
+/// Why [`apply_variant`] (and `to_eds_variant`) could not make a device
 /// variant.
 #[derive(Debug, Clone, PartialEq, Eq)]
 #[non_exhaustive]

@@ -1,12 +1,14 @@
 //! CiA 301 basic data types (codes 0x0001–0x001B) as the IR names them.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 /// A CiA 301 data type. Codes outside the standard table are kept as
 /// [`DataType::Other`] so that a device-specific type (DEFTYPE/DEFSTRUCT or a
 /// vendor code) survives reading; the reader reports it as a diagnostic.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-#[serde(rename_all = "SCREAMING_SNAKE_CASE")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "SCREAMING_SNAKE_CASE"))]
 pub enum DataType {
     Boolean,
     Integer8,

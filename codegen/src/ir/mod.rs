@@ -1,6 +1,6 @@
 //! The object-dictionary intermediate representation.
 //!
-//! Plain data, serde-serialisable, with no knowledge of Rust syntax and none of
+//! Plain data, serde-serialisable (feature `serde`), with no knowledge of Rust syntax and none of
 //! EDS syntax either: the EDS reader and the YAML table reader lower into it,
 //! the generators read from it. Every item carries its [`Origin`].
 
@@ -11,6 +11,7 @@ mod value;
 
 use std::collections::BTreeMap;
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 pub use datatype::{DataType, ValueKind};
@@ -25,8 +26,9 @@ pub use value::{
 /// Whether a device takes the built-in meanings of CiA 301 and its device
 /// profile (bit fields, states, named values, units of the standard
 /// objects) where its sources say nothing.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum ProfileChoice {
     /// The built-in meanings apply (the default).
     #[default]
@@ -42,14 +44,16 @@ impl ProfileChoice {
 }
 
 /// Where an item came from: a file and a 1-based line.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Origin {
     pub file: String,
     pub line: u32,
 }
 
 /// One device's object dictionary.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Device {
     /// Path of the main input file.
     pub source: String,
@@ -65,20 +69,23 @@ pub struct Device {
     /// Free text of the `[Comments]` section, line by line (YAML: `notes`).
     pub comments: Vec<String>,
     /// Network defaults and LSS facts (YAML only; a DCF's are in `commissioning`).
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub network: Network,
     /// Names of default PDOs (YAML only), sorted by direction and number.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub pdo_labels: Vec<PdoLabel>,
     /// Device error tables (YAML only), sorted by name.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub error_tables: Vec<ErrorTable>,
     /// Product variants (YAML only), in source order.
-    #[serde(default)]
+    #[cfg_attr(feature = "serde", serde(default))]
     pub variants: Vec<Variant>,
     /// Whether the built-in meanings of the standard objects apply (a
     /// table's `profiles:` key).
-    #[serde(default, skip_serializing_if = "ProfileChoice::is_builtin")]
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "ProfileChoice::is_builtin")
+    )]
     pub profiles: ProfileChoice,
 }
 
@@ -111,7 +118,8 @@ impl Device {
 }
 
 /// File metadata (`[FileInfo]`), kept as written.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct FileInfo {
     pub file_name: Option<String>,
     pub file_version: Option<String>,
@@ -127,7 +135,8 @@ pub struct FileInfo {
 }
 
 /// Device identity (`[DeviceInfo]` and object 0x1018).
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Identity {
     pub vendor_name: Option<String>,
     pub vendor_number: Option<u32>,
@@ -138,7 +147,8 @@ pub struct Identity {
 }
 
 /// What the device says it supports (`[DeviceInfo]`).
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Capabilities {
     /// Supported bit rates in kbit/s, ascending.
     pub baud_rates: Vec<u32>,
@@ -153,7 +163,8 @@ pub struct Capabilities {
 }
 
 /// DCF commissioning data (`[DeviceComissioning]`, CiA 306 spelling).
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Commissioning {
     pub node_id: Option<u8>,
     pub node_name: Option<String>,
@@ -166,8 +177,9 @@ pub struct Commissioning {
 }
 
 /// The CiA 301 object code.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "SCREAMING_SNAKE_CASE")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "SCREAMING_SNAKE_CASE"))]
 pub enum ObjectKind {
     /// 0x5: a data type definition.
     DefType,
@@ -197,7 +209,8 @@ impl ObjectKind {
 }
 
 /// One object of the dictionary.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Object {
     pub index: u16,
     pub name: String,
@@ -215,14 +228,18 @@ pub struct Object {
     /// The Rust module name pinned for an ARRAY/RECORD object (YAML
     /// `rust_name:`), snake_case; it wins over the canonical and the source
     /// name. A VAR object's pin is its entry's [`Entry::rust_name`].
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
     pub rust_name: Option<String>,
     pub origin: Origin,
 }
 
 /// Access right of an entry (CiA 306 AccessType).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Access {
     Ro,
     Wo,
@@ -256,7 +273,8 @@ impl Access {
 }
 
 /// One value-carrying entry (a VAR, or a sub-entry of an ARRAY/RECORD).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Entry {
     pub subindex: u8,
     pub name: String,
@@ -274,16 +292,23 @@ pub struct Entry {
     ///
     /// Boxed: most entries of a real file have none, and an entry stays
     /// small (a file of a million sub-entries holds a million of these).
-    #[serde(default, skip_serializing_if = "semantics_is_empty")]
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "semantics_is_empty")
+    )]
     pub semantics: Box<Semantics>,
     /// The Rust type name pinned for this entry (YAML `rust_name:`),
     /// UpperCamelCase; it wins over the canonical and the source name.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
     pub rust_name: Option<String>,
     pub origin: Origin,
 }
 
 /// Serde's test for an entry's boxed [`Semantics`].
+#[cfg(feature = "serde")]
 fn semantics_is_empty(semantics: &Semantics) -> bool {
     semantics.is_empty()
 }

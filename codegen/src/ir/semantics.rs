@@ -2,12 +2,14 @@
 //! (units and scale, named values, bit fields, error tables, variants,
 //! network defaults). Filled from YAML object tables; empty for a plain EDS.
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use super::{Access, Identity, Literal, Origin};
 
 /// Meaning of one entry's raw value.
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Semantics {
     /// Free text from the source (manual wording, translated).
     pub description: Option<String>,
@@ -35,7 +37,8 @@ impl Semantics {
 
 /// How raw values map to meanings: an enumeration when `numeric` is absent,
 /// a number with special values when it is present.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct ValueTable {
     /// The inclusive raw range that carries a (scaled) number.
     pub numeric: Option<(i128, i128)>,
@@ -46,7 +49,8 @@ pub struct ValueTable {
 }
 
 /// A named raw value, or a named inclusive range of raw values.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct NamedValue {
     pub low: i128,
     pub high: i128,
@@ -54,7 +58,10 @@ pub struct NamedValue {
     pub text: Option<String>,
     /// The enum variant name pinned for this value (YAML `rust_name:`),
     /// UpperCamelCase.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
     pub rust_name: Option<String>,
     pub origin: Origin,
 }
@@ -66,7 +73,8 @@ impl NamedValue {
 }
 
 /// A field of `width` bits starting at bit `lsb` of the raw value.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct BitField {
     pub name: String,
     pub lsb: u32,
@@ -76,13 +84,17 @@ pub struct BitField {
     pub scale: Option<f64>,
     pub values: Option<ValueTable>,
     /// The getter name pinned for this field (YAML `rust_name:`), snake_case.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    #[cfg_attr(
+        feature = "serde",
+        serde(default, skip_serializing_if = "Option::is_none")
+    )]
     pub rust_name: Option<String>,
     pub origin: Origin,
 }
 
 /// `raw & mask == value` names a state.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Pattern {
     pub name: String,
     pub mask: u64,
@@ -92,8 +104,9 @@ pub struct Pattern {
 }
 
 /// What the codes of an error table are.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum ErrorTableKind {
     /// The 16-bit error code of an EMCY frame (and of 0x1003).
     Emcy,
@@ -104,7 +117,8 @@ pub enum ErrorTableKind {
 }
 
 /// A table of error codes with their texts.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct ErrorTable {
     /// The table's identifier, referenced by [`Semantics::error_table`].
     pub name: String,
@@ -115,7 +129,8 @@ pub struct ErrorTable {
     pub origin: Origin,
 }
 
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct ErrorCode {
     pub code: u32,
     pub name: String,
@@ -130,7 +145,8 @@ pub struct ErrorCode {
 }
 
 /// Network defaults and facts of a device.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Network {
     /// Node id as delivered.
     pub node_id: Option<u8>,
@@ -143,7 +159,8 @@ pub struct Network {
 }
 
 /// What a device supports of CiA 305.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Lss {
     /// Sorted and without duplicates.
     pub services: Vec<LssService>,
@@ -154,8 +171,9 @@ pub struct Lss {
     pub bit_timing: Vec<(u8, u32)>,
 }
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "snake_case"))]
 pub enum LssService {
     SwitchGlobal,
     SwitchSelective,
@@ -171,7 +189,8 @@ pub enum LssService {
 
 /// A product variant: the same dictionary with other identity, defaults or
 /// rated values.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Variant {
     pub name: String,
     pub description: Option<String>,
@@ -186,7 +205,8 @@ pub struct Variant {
 }
 
 /// Values of one entry that a variant changes.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct EntryOverride {
     pub index: u16,
     pub subindex: u8,
@@ -197,8 +217,9 @@ pub struct EntryOverride {
 }
 
 /// Whether a PDO is received or transmitted by the device.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum PdoDirection {
     /// Received by the device (0x1400/0x1600 + n − 1).
     Rpdo,
@@ -232,7 +253,8 @@ impl PdoDirection {
 }
 
 /// A name for a default PDO (its layout lives in the mapping object).
-#[derive(Debug, Clone, PartialEq, Eq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Eq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct PdoLabel {
     pub direction: PdoDirection,
     /// 1-based PDO number (RPDO1 = 1).

@@ -2,6 +2,7 @@
 
 use std::ops::RangeInclusive;
 
+#[cfg(feature = "serde")]
 use serde::{Deserialize, Serialize};
 
 use super::{DataType, Entry};
@@ -10,8 +11,9 @@ use super::{DataType, Entry};
 pub const NODE_IDS: RangeInclusive<u8> = 1..=127;
 
 /// A value in its data type's natural form.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
+#[cfg_attr(feature = "serde", serde(rename_all = "lowercase"))]
 pub enum Value {
     /// Integer, BOOLEAN (0/1) and TIME types. Wide enough for INTEGER64 and UNSIGNED64.
     Integer(i128),
@@ -21,7 +23,8 @@ pub enum Value {
 }
 
 /// A value as written in the source, possibly relative to the node id.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq)]
+#[cfg_attr(feature = "serde", derive(Serialize, Deserialize))]
 pub struct Literal {
     /// The value, without the node id when `plus_node_id` is set.
     pub value: Value,

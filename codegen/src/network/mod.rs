@@ -3,15 +3,19 @@
 //! ([`config`]), checked as a whole, and written as master.dcf and concise
 //! DCFs.
 
+#[cfg(feature = "api")]
 pub mod api;
 mod boot;
 pub use boot::boot_plan;
+#[cfg(feature = "network-check")]
 pub mod check;
 pub mod config;
 mod configure;
 pub use configure::configure;
 pub mod configured;
+#[cfg(feature = "export")]
 pub mod dcf;
+#[cfg(feature = "diff")]
 pub mod diff;
 mod expand;
 pub mod model;

@@ -16,6 +16,7 @@
 //! in index order and the file is formatted by prettyplease, so the same IR
 //! always gives the same bytes.
 
+#[cfg(feature = "api")]
 mod api;
 mod arrays;
 mod bits;
@@ -27,7 +28,9 @@ mod errors;
 mod format;
 mod hazards;
 pub(crate) mod naming;
+#[cfg(feature = "network")]
 pub(crate) mod network;
+#[cfg(feature = "network")]
 mod network_plan;
 mod objects;
 mod od_module;
@@ -38,6 +41,7 @@ mod scaled;
 mod value_parts;
 mod values;
 
+#[cfg(feature = "api")]
 pub use api::{ApiListing, api_listing};
 
 use proc_macro2::TokenStream;
@@ -148,6 +152,7 @@ pub fn generate(device: &Device, options: &Options) -> Result<Output, Diagnostic
 /// (the device with the network's mappings and communication values as
 /// configured values, see `network::configured`) instead of the defaults.
 /// Also says which PDO structs were made.
+#[cfg(feature = "network")]
 pub(crate) fn generate_node(
     device: &Device,
     configured: &Device,

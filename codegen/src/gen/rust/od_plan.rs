@@ -4,11 +4,14 @@
 //! `diff` module, through [`device_names`]) read the same plan without
 //! generating anything.
 
+#[cfg(any(feature = "diff", all(feature = "api", feature = "network")))]
 use std::collections::BTreeMap;
 
 use proc_macro2::Ident;
 
-use super::errors::{self, ErrorPlan};
+#[cfg(any(feature = "diff", all(feature = "api", feature = "network")))]
+use super::errors;
+use super::errors::ErrorPlan;
 use super::naming::{self, Case, NameId, Names, Namespace};
 use super::values::{self, Plan};
 use crate::diag::Diagnostics;
@@ -57,6 +60,10 @@ pub(crate) struct ModulePlan<'d> {
     pub(crate) module: Ident,
     /// The module name shared with another source name, when that made it
     /// qualified.
+    #[cfg_attr(
+        not(any(feature = "diff", all(feature = "api", feature = "network"))),
+        allow(dead_code)
+    )]
     pub(crate) module_collided: Option<String>,
     pub(crate) entries: Vec<EntryPlan<'d>>,
     /// The names of the module's scope.
@@ -339,6 +346,7 @@ fn meaning(s: &crate::ir::Semantics) -> crate::ir::Semantics {
 /// The path of an entry's value type as planned (`u16`,
 /// `od::command::PositionValue`, `errors::LinakErrorsCode`,
 /// `bytes::VisibleString`); `module` is the entry's module (`od::feedback`).
+#[cfg(any(feature = "api", feature = "diff"))]
 pub(crate) fn value_type_path(
     plan: &Plan,
     module: &str,
@@ -358,6 +366,7 @@ pub(crate) fn value_type_path(
 
 /// The Rust names one device's generated code gives its entries: for a
 /// reader of the generated API (the `diff` module) without generating it.
+#[cfg(any(feature = "diff", all(feature = "api", feature = "network")))]
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub(crate) struct DeviceNames {
     /// By (index, subindex): the entry's zero-sized type (`od::Statusword`,
@@ -378,6 +387,7 @@ pub(crate) struct DeviceNames {
 
 /// The names of every generated entry of `device`, from the same plan the
 /// generator writes out.
+#[cfg(any(feature = "diff", all(feature = "api", feature = "network")))]
 pub(crate) fn device_names(device: &Device) -> DeviceNames {
     let mut diags = Diagnostics::new();
     let error_plans = errors::plan(device, &mut diags);

@@ -50,6 +50,7 @@ pub(crate) enum Plan {
 
 impl Plan {
     /// Every name the plan requested in the entry's scope.
+    #[cfg(any(feature = "diff", all(feature = "api", feature = "network")))]
     pub(crate) fn names(&self) -> Vec<NameId> {
         match self {
             Plan::Prim(_) | Plan::Bytes(_) | Plan::Error(_) | Plan::Runtime { .. } => Vec::new(),
