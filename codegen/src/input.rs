@@ -60,7 +60,7 @@ pub(crate) fn yaml_off(path: &Path, what: &str) -> Loaded {
         location: Location::default(),
         message: format!(
             "{what} cannot be read: eds2rust is built without its `yaml` feature \
-             (on by default; `default-features = false` turns it off)"
+             (turn it on in Cargo.toml: `eds2rust = {{ version = \"0.1\", features = [\"yaml\"] }}`)"
         ),
         notes: Vec::new(),
     });

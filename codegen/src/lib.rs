@@ -19,12 +19,12 @@
 //! - [`build`]: the build-script API ([`Builder`], in the shape of
 //!   prost-build) and the pure [`generate`]: input + overlays → Rust source.
 //!
-//! Features: the default ones (`yaml`, `network`) are what [`Builder`]
-//! needs; a build script that reads only EDS/DCF files may turn them off
-//! (`default-features = false`: no serde, no YAML reader). What only the
-//! command line uses is opt-in: `serde`, `json`, `diff`, `api`, `export`,
-//! `network-check`, and `cli` for all of them (Cargo.toml says what each
-//! adds; docs/build-api.md, "Features").
+//! Features: none by default, so that a build script generating from
+//! EDS/DCF files compiles no serde, no YAML reader and no network code.
+//! Opt-in: `yaml` (YAML tables and overlays), `network` (bus files,
+//! `Builder::network`), and what only the command line uses: `serde`,
+//! `json`, `diff`, `api`, `export`, `network-check`, and `cli` for all of
+//! them (Cargo.toml says what each adds; docs/build-api.md, "Features").
 #![forbid(unsafe_code)]
 
 pub mod bounded;

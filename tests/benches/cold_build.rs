@@ -7,10 +7,10 @@
 //!
 //! The crates, each outside the workspace with its own lock file:
 //! - `generated` (tests/cold-build/generated): the build script generates
-//!   the DCF with eds2rust's `default-features = false` (what one DCF needs:
-//!   no YAML tables, no networks);
-//! - `defaults`: the same crate with eds2rust's default features
-//!   (`--features eds2rust-defaults`), as `cargo add --build eds2rust` has it;
+//!   the DCF with eds2rust as `cargo add --build eds2rust` adds it (no
+//!   features: what one DCF needs, no YAML tables, no networks);
+//! - `yaml+network`: the same crate with eds2rust's `yaml` and `network`
+//!   features (`--features eds2rust-yaml-network`);
 //! - `runtime-only` (tests/cold-build/runtime-only): the same PDO mapping
 //!   over hand-written entries, the runtime alone.
 //!
@@ -256,9 +256,9 @@ fn main() {
     let crates: [(&str, &str, &[&str]); 3] = [
         ("generated", "generated", &[]),
         (
-            "defaults",
+            "yaml+network",
             "generated",
-            &["--features", "eds2rust-defaults"],
+            &["--features", "eds2rust-yaml-network"],
         ),
         ("runtime-only", "runtime-only", &[]),
     ];
