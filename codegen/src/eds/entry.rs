@@ -7,6 +7,21 @@ use super::sections::{SectionKind, classify};
 use crate::diag::Severity;
 use crate::ir::{Access, DataType, Entry, Literal, ObjectKind, Origin, Value, ValueKind};
 
+/// The access an AccessType token names (CiA 306: ro, wo, rw, rwr, rww,
+/// const), in any case.
+fn access_type(token: &str) -> Option<Access> {
+    [
+        Access::Ro,
+        Access::Wo,
+        Access::Rw,
+        Access::Rwr,
+        Access::Rww,
+        Access::Const,
+    ]
+    .into_iter()
+    .find(|a| a.as_str().eq_ignore_ascii_case(token))
+}
+
 impl Lowering<'_> {
     /// Reads one entry. `kind` is the object's kind for a VAR/DOMAIN/DEFTYPE
     /// (sub 0), `Var` for sub-objects. `None` when the entry has no meaning.
@@ -17,24 +32,13 @@ impl Lowering<'_> {
         section: &Section,
         kind: ObjectKind,
     ) -> Option<Entry> {
-        let fallback = if sub == 0 {
-            format!("Object 0x{index:04X}")
-        } else {
-            format!("Sub-index {sub}")
-        };
-        let name = match section.get("ParameterName").filter(|p| !p.value.is_empty()) {
-            Some(p) => p.value.to_string(),
-            None => {
-                self.report(
-                    Severity::Warning,
-                    "eds::missing-name",
-                    section,
-                    None,
-                    format!("no ParameterName; named `{fallback}`"),
-                );
-                fallback
+        let name = self.name(section, || {
+            if sub == 0 {
+                format!("Object 0x{index:04X}")
+            } else {
+                format!("Sub-index {sub}")
             }
-        };
+        });
         let data_type = match section.get("DataType").filter(|p| !p.value.is_empty()) {
             None if kind == ObjectKind::Domain => DataType::Domain,
             None => {
@@ -96,14 +100,9 @@ impl Lowering<'_> {
                 }
                 access
             }
-            Some(p) => match p.value.trim().to_ascii_lowercase().as_str() {
-                "ro" => Access::Ro,
-                "wo" => Access::Wo,
-                "rw" => Access::Rw,
-                "rwr" => Access::Rwr,
-                "rww" => Access::Rww,
-                "const" => Access::Const,
-                _ => {
+            Some(p) => match access_type(p.value.trim()) {
+                Some(access) => access,
+                None => {
                     self.unknown_access(index, sub, section, p);
                     Access::Ro
                 }

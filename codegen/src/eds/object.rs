@@ -17,7 +17,7 @@ impl Lowering<'_> {
         names: Option<&Section>,
         values: Option<&Section>,
     ) -> Option<Object> {
-        let name = self.name(section, format!("Object 0x{index:04X}"));
+        let name = self.name(section, || format!("Object 0x{index:04X}"));
         let kind = match section.get("ObjectType") {
             None => ObjectKind::Var,
             Some(p) => match number::parse_int(p.value) {
@@ -65,7 +65,7 @@ impl Lowering<'_> {
                 self.warn("eds::orphan-sub", sub, None, format!("object 0x{index:04X} is a {kind:?}, which has no sub-objects; the section is ignored"));
             }
             if let Some(entry) = self.entry(index, 0, section, kind) {
-                entries.insert(0, entry);
+                entries.insert(0, Box::new(entry));
             }
         } else {
             if let Some(n) = compact {
@@ -123,7 +123,7 @@ impl Lowering<'_> {
             }
             for (sub, sub_section) in subs {
                 if let Some(entry) = self.entry(index, sub, sub_section, ObjectKind::Var) {
-                    entries.insert(sub, entry);
+                    entries.insert(sub, Box::new(entry));
                 }
             }
         }
@@ -131,7 +131,7 @@ impl Lowering<'_> {
             index,
             name,
             kind,
-            entries: Object::boxed_entries(entries),
+            entries,
             obj_flags,
             denotation,
             compact_sub_obj: compact,
@@ -140,10 +140,13 @@ impl Lowering<'_> {
         })
     }
 
-    pub(super) fn name(&mut self, section: &Section, fallback: String) -> String {
+    /// The section's ParameterName; when it has none (or an empty one), a
+    /// warning and the name `fallback` gives.
+    pub(super) fn name(&mut self, section: &Section, fallback: impl FnOnce() -> String) -> String {
         match Self::text(Some(section), "ParameterName") {
             Some(name) => name,
             None => {
+                let fallback = fallback();
                 self.warn(
                     "eds::missing-name",
                     section,
@@ -164,10 +167,10 @@ impl Lowering<'_> {
         n: u8,
         names: Option<&Section>,
         values: Option<&Section>,
-    ) -> BTreeMap<u8, Entry> {
+    ) -> BTreeMap<u8, Box<Entry>> {
         let mut entries = BTreeMap::new();
         let origin = self.origin(section.line);
-        entries.insert(0, Entry::highest_subindex(n, origin));
+        entries.insert(0, Box::new(Entry::highest_subindex(n, origin)));
         let Some(template) = self.entry(index, 1, section, ObjectKind::Var) else {
             return entries;
         };
@@ -177,14 +180,14 @@ impl Lowering<'_> {
                 .filter(|p| !p.value.is_empty())
         };
         for sub in 1..=n {
-            let mut entry = template.clone();
+            let mut entry = Box::new(template.clone());
             entry.subindex = sub;
-            entry.name = match name_of(sub) {
-                Some(p) => p.value.to_string(),
-                None => format!("{name}{sub}"),
-            };
-            if let Some(p) = name_of(sub) {
-                entry.origin = self.origin(p.line);
+            match name_of(sub) {
+                Some(p) => {
+                    entry.name = p.value.to_string();
+                    entry.origin = self.origin(p.line);
+                }
+                None => entry.name = format!("{name}{sub}"),
             }
             entries.insert(sub, entry);
         }
