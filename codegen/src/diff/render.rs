@@ -49,20 +49,29 @@ pub(crate) struct Row<'a> {
     pub(crate) message: &'a str,
 }
 
+/// The [`Row`] of a change `$c` (a device diff's or a network diff's: the
+/// fields of the same names), at `$node` and `$place`.
+macro_rules! row {
+    ($c:expr, $node:expr, $place:expr) => {
+        $crate::diff::render::Row {
+            node: $node,
+            index: $c.index,
+            subindex: $c.subindex,
+            place: $place,
+            kind: $c.kind.as_str(),
+            severity: $c.severity,
+            rust_path: $c.rust_path.as_deref(),
+            old: $c.old.as_ref(),
+            new: $c.new.as_ref(),
+            message: &$c.message,
+        }
+    };
+}
+pub(crate) use row;
+
 impl<'a> Row<'a> {
     fn of(c: &'a Change) -> Row<'a> {
-        Row {
-            node: None,
-            index: c.index,
-            subindex: c.subindex,
-            place: Cow::Owned(place(c)),
-            kind: c.kind.as_str(),
-            severity: c.severity,
-            rust_path: c.rust_path.as_deref(),
-            old: c.old.as_ref(),
-            new: c.new.as_ref(),
-            message: &c.message,
-        }
+        row!(c, None, Cow::Owned(place(c)))
     }
 }
 
@@ -88,13 +97,14 @@ pub(crate) fn text_of(rows: &[Row], summary: &str) -> String {
             .rust_path
             .map(|p| format!(" {}", code_span(p)))
             .unwrap_or_default();
-        let _ = write!(out, "{:<10} ", r.severity.as_str());
-        if let Some((node, _)) = r.node {
-            let _ = write!(out, "{:<width$} ", terminal_line(node));
-        }
+        let node = r
+            .node
+            .map(|(node, _)| format!("{:<width$} ", terminal_line(node)))
+            .unwrap_or_default();
         let _ = writeln!(
             out,
-            "{:<14} {}{path}: {}",
+            "{:<10} {node}{:<14} {}{path}: {}",
+            r.severity.as_str(),
             terminal_line(&r.place),
             r.kind,
             terminal_line(r.message)
@@ -145,13 +155,13 @@ pub(crate) fn markdown_of(
                 Severity::Compatible => "compatible",
             };
             let path = r.rust_path.map(|p| md(&code_span(p))).unwrap_or_default();
-            let _ = write!(out, "| {severity} |");
-            if let Some((node, _)) = r.node {
-                let _ = write!(out, " {} |", md(&code_span(node)));
-            }
+            let node = r
+                .node
+                .map(|(node, _)| format!(" {} |", md(&code_span(node))))
+                .unwrap_or_default();
             let _ = writeln!(
                 out,
-                " {} | `{}` | {path} | {} |",
+                "| {severity} |{node} {} | `{}` | {path} | {} |",
                 md(&r.place),
                 r.kind,
                 md(r.message)

@@ -9,7 +9,7 @@ use std::borrow::Cow;
 
 use super::NetChange;
 use crate::diff::Summary;
-use crate::diff::render::{Row, json_of, markdown_of, summary_of, text_of};
+use crate::diff::render::{Row, json_of, markdown_of, row, summary_of, text_of};
 
 /// `5 changes: 2 breaking, 1 additive, 2 compatible`.
 pub fn summary(changes: &[NetChange]) -> String {
@@ -20,18 +20,7 @@ pub fn summary(changes: &[NetChange]) -> String {
 fn rows(changes: &[NetChange]) -> Vec<Row<'_>> {
     changes
         .iter()
-        .map(|c| Row {
-            node: Some((&c.node, c.kind.scope())),
-            index: c.index,
-            subindex: c.subindex,
-            place: Cow::Borrowed(&c.place),
-            kind: c.kind.as_str(),
-            severity: c.severity,
-            rust_path: c.rust_path.as_deref(),
-            old: c.old.as_ref(),
-            new: c.new.as_ref(),
-            message: &c.message,
-        })
+        .map(|c| row!(c, Some((&c.node, c.kind.scope())), Cow::Borrowed(&c.place)))
         .collect()
 }
 
