@@ -270,18 +270,35 @@ fn warn_whole_line(
 ) {
     let start = line_start(text, line);
     let end = text[start..].find('\n').map_or(text.len(), |n| start + n);
-    diags.push(Diagnostic {
+    let mut warning = warning(file, code, line, start..end.max(start), None, None, message);
+    warning.notes.push(note.to_string());
+    diags.push(warning);
+}
+
+/// A warning of the INI layer at `line` (`span` of the text), in `section`
+/// at `key` where those are known.
+fn warning(
+    file: &str,
+    code: &'static str,
+    line: u32,
+    span: Range<usize>,
+    section: Option<&str>,
+    key: Option<&str>,
+    message: String,
+) -> Diagnostic {
+    Diagnostic {
         severity: Severity::Warning,
         code,
         file: file.to_string(),
         location: Location {
             line: Some(line),
-            span: Some(start..end.max(start)),
-            ..Location::default()
+            span: Some(span),
+            section: section.map(str::to_string),
+            key: key.map(str::to_string),
         },
         message,
-        notes: vec![note.to_string()],
-    });
+        notes: Vec::new(),
+    }
 }
 
 fn line_start(text: &str, line: u32) -> usize {
@@ -309,19 +326,7 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                 section: Option<&str>,
                 key: Option<&str>,
                 message: String| {
-        diags.push(Diagnostic {
-            severity: Severity::Warning,
-            code,
-            file: file.to_string(),
-            location: Location {
-                line: Some(line),
-                span: Some(span),
-                section: section.map(str::to_string),
-                key: key.map(str::to_string),
-            },
-            message,
-            notes: Vec::new(),
-        })
+        diags.push(warning(file, code, line, span, section, key, message))
     };
 
     for (n, (line_offset, raw_line)) in lines(text).enumerate() {
@@ -401,31 +406,26 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
             );
             continue;
         };
-        let Some(eq) = trimmed.bytes().position(|b| b == b'=') else {
-            warn(
-                diags,
-                "eds::not-key-value",
-                line_no,
-                line_span,
-                Some(sections[section_index].name),
-                None,
-                "a line without `=` is ignored".to_string(),
-            );
-            continue;
+        let eq = trimmed.bytes().position(|b| b == b'=');
+        let (eq, key) = match eq.map(|eq| (eq, trim(&trimmed[..eq]))) {
+            Some((eq, key)) if !key.is_empty() => (eq, key),
+            other => {
+                let message = match other {
+                    None => "a line without `=` is ignored",
+                    Some(_) => "a line with an empty key is ignored",
+                };
+                warn(
+                    diags,
+                    "eds::not-key-value",
+                    line_no,
+                    line_span,
+                    Some(sections[section_index].name),
+                    None,
+                    message.to_string(),
+                );
+                continue;
+            }
         };
-        let key = trim(&trimmed[..eq]);
-        if key.is_empty() {
-            warn(
-                diags,
-                "eds::not-key-value",
-                line_no,
-                line_span,
-                Some(sections[section_index].name),
-                None,
-                "a line with an empty key is ignored".to_string(),
-            );
-            continue;
-        }
         let raw_value = &trimmed[eq + 1..];
         let mut value = trim_start(raw_value);
         let value_lead = raw_value.len() - value.len();

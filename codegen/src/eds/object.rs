@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use super::ini::Section;
 use super::lower::Lowering;
 use super::number;
+use crate::diag::Severity;
 use crate::ir::{Entry, Object, ObjectKind, Origin};
 
 impl Lowering<'_> {
@@ -28,11 +29,12 @@ impl Lowering<'_> {
                 Ok(0x8) => ObjectKind::Array,
                 Ok(0x9) => ObjectKind::Record,
                 Ok(other) => {
-                    self.error("eds::bad-object-type", section, Some(p), format!("object type {other:#x} is not one of 0x2 DOMAIN, 0x5 DEFTYPE, 0x6 DEFSTRUCT, 0x7 VAR, 0x8 ARRAY, 0x9 RECORD; the object is left out"));
+                    self.report(Severity::Error, "eds::bad-object-type", section, Some(p), format!("object type {other:#x} is not one of 0x2 DOMAIN, 0x5 DEFTYPE, 0x6 DEFSTRUCT, 0x7 VAR, 0x8 ARRAY, 0x9 RECORD; the object is left out"));
                     return None;
                 }
                 Err(e) => {
-                    self.error(
+                    self.report(
+                        Severity::Error,
                         "eds::bad-object-type",
                         section,
                         Some(p),
