@@ -365,12 +365,9 @@ pub(super) fn literal(
 fn check_limits(ctx: &mut Ctx, entry: &Entry, def: &Spanned<EntryDef>, here: &str) {
     let text = |l: &Option<Literal>| l.as_ref().map_or(String::new(), |l| l.text.clone());
     let at_key = |t: &Option<Text>| t.as_ref().map_or(At::of(def), At::of);
-    match entry.limit_problem() {
-        None => {}
-        Some(LimitProblem::LowAboveHigh) => ctx.error(
-            "table::limits",
-            at_key(&def.value.min),
-            here,
+    let (key, message) = match entry.limit_problem() {
+        None => return,
+        Some(LimitProblem::LowAboveHigh) => (
             "min",
             format!(
                 "min {} is above max {}",
@@ -383,20 +380,20 @@ fn check_limits(ctx: &mut Ctx, entry: &Entry, def: &Spanned<EntryDef>, here: &st
                 Some(l) => l.text.clone(),
                 None => "…".into(),
             };
-            ctx.error(
-                "table::limits",
-                at_key(&def.value.default),
-                here,
-                "default",
-                format!(
-                    "default {} is outside min..max ({}..{})",
-                    text(&entry.default),
-                    bound(&entry.low_limit),
-                    bound(&entry.high_limit)
-                ),
+            let message = format!(
+                "default {} is outside min..max ({}..{})",
+                text(&entry.default),
+                bound(&entry.low_limit),
+                bound(&entry.high_limit)
             );
+            ("default", message)
         }
-    }
+    };
+    let at = match key {
+        "min" => at_key(&def.value.min),
+        _ => at_key(&def.value.default),
+    };
+    ctx.error("table::limits", at, here, key, message);
 }
 
 /// Stage 2: removes an object or one sub-entry of the base.
