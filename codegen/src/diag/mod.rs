@@ -105,10 +105,11 @@ impl Diagnostics {
         Self::default()
     }
 
-    /// Registers the decoded text of a file so rendering can show its lines.
-    pub fn add_source(&mut self, file: &str, text: &str) {
+    /// Registers the decoded text of a file so rendering can show its lines
+    /// (an owned `String` is kept as it is, without a copy).
+    pub fn add_source(&mut self, file: &str, text: impl Into<String>) {
         if !self.sources.iter().any(|(name, _)| name == file) {
-            self.sources.push((file.to_string(), text.to_string()));
+            self.sources.push((file.to_string(), text.into()));
         }
     }
 

@@ -2,9 +2,10 @@
 //! review comment, or one JSON object. The JSON is written here by hand so
 //! that the library's default build needs no JSON crate.
 
+use std::borrow::Cow;
 use std::fmt::Write;
 
-use super::{Change, Summary, Val};
+use super::{Change, Severity, Summary, Val};
 use crate::text::{code_span, terminal_line};
 
 /// Where a change is: `0x6041 sub 0`, `0x1A00`, or `device` for index 0.
@@ -32,63 +33,143 @@ pub(crate) fn summary_of(s: &Summary, total: usize) -> String {
     )
 }
 
+/// One change as the renderers show it: a device diff's [`Change`], or a
+/// network diff's change, which adds the node it is on.
+pub(crate) struct Row<'a> {
+    /// The node and the scope (`wiring` or `device`) of a network change.
+    pub(crate) node: Option<(&'a str, &'a str)>,
+    pub(crate) index: u16,
+    pub(crate) subindex: Option<u8>,
+    pub(crate) place: Cow<'a, str>,
+    pub(crate) kind: &'static str,
+    pub(crate) severity: Severity,
+    pub(crate) rust_path: Option<&'a str>,
+    pub(crate) old: Option<&'a Val>,
+    pub(crate) new: Option<&'a Val>,
+    pub(crate) message: &'a str,
+}
+
+/// The [`Row`] of a change `$c` (a device diff's or a network diff's: the
+/// fields of the same names), at `$node` and `$place`.
+macro_rules! row {
+    ($c:expr, $node:expr, $place:expr) => {
+        $crate::diff::render::Row {
+            node: $node,
+            index: $c.index,
+            subindex: $c.subindex,
+            place: $place,
+            kind: $c.kind.as_str(),
+            severity: $c.severity,
+            rust_path: $c.rust_path.as_deref(),
+            old: $c.old.as_ref(),
+            new: $c.new.as_ref(),
+            message: &$c.message,
+        }
+    };
+}
+pub(crate) use row;
+
+impl<'a> Row<'a> {
+    fn of(c: &'a Change) -> Row<'a> {
+        row!(c, None, Cow::Owned(place(c)))
+    }
+}
+
 /// One line per change, severity first, then the summary line. Text from the
 /// inputs is terminal-safe ([`crate::text::terminal_line`]).
 pub fn text(changes: &[Change]) -> String {
+    let rows: Vec<Row> = changes.iter().map(Row::of).collect();
+    text_of(&rows, &summary(changes))
+}
+
+/// One line per row (severity, the node in a column as wide as the longest
+/// name, where, kind, Rust path, message) and the `summary` line.
+pub(crate) fn text_of(rows: &[Row], summary: &str) -> String {
+    let width = rows
+        .iter()
+        .filter_map(|r| r.node)
+        .map(|(node, _)| terminal_line(node).chars().count())
+        .max()
+        .unwrap_or(0);
     let mut out = String::new();
-    for c in changes {
-        let path = c
+    for r in rows {
+        let path = r
             .rust_path
-            .as_deref()
             .map(|p| format!(" {}", code_span(p)))
+            .unwrap_or_default();
+        let node = r
+            .node
+            .map(|(node, _)| format!("{:<width$} ", terminal_line(node)))
             .unwrap_or_default();
         let _ = writeln!(
             out,
-            "{:<10} {:<14} {}{path}: {}",
-            c.severity.as_str(),
-            place(c),
-            c.kind.as_str(),
-            terminal_line(&c.message)
+            "{:<10} {node}{:<14} {}{path}: {}",
+            r.severity.as_str(),
+            terminal_line(&r.place),
+            r.kind,
+            terminal_line(r.message)
         );
     }
-    let _ = writeln!(out, "{}", summary(changes));
+    let _ = writeln!(out, "{summary}");
     out
 }
 
 /// A Markdown table (severity, where, kind, Rust path, change) and the
 /// summary, for a review comment.
 pub fn markdown(old: &str, new: &str, changes: &[Change]) -> String {
+    let rows: Vec<Row> = changes.iter().map(Row::of).collect();
+    let title = "Object dictionary changes";
+    markdown_of(title, old, new, &rows, &summary(changes))
+}
+
+/// The Markdown of `rows` under `### {title}: old → new` (a node column
+/// when the rows have nodes), and the `summary` line.
+pub(crate) fn markdown_of(
+    title: &str,
+    old: &str,
+    new: &str,
+    rows: &[Row],
+    summary: &str,
+) -> String {
     let mut out = String::new();
     let _ = writeln!(
         out,
-        "### Object dictionary changes: {} → {}\n",
+        "### {title}: {} → {}\n",
         md(&code_span(old)),
         md(&code_span(new))
     );
-    if !changes.is_empty() {
-        out.push_str("| severity | where | kind | Rust path | change |\n|---|---|---|---|---|\n");
-        for c in changes {
-            let severity = match c.severity {
-                super::Severity::Breaking => "**breaking**",
-                super::Severity::Additive => "additive",
-                super::Severity::Compatible => "compatible",
+    if let Some(first) = rows.first() {
+        if first.node.is_some() {
+            out.push_str(
+                "| severity | node | where | kind | Rust path | change |\n|---|---|---|---|---|---|\n",
+            );
+        } else {
+            out.push_str(
+                "| severity | where | kind | Rust path | change |\n|---|---|---|---|---|\n",
+            );
+        }
+        for r in rows {
+            let severity = match r.severity {
+                Severity::Breaking => "**breaking**",
+                Severity::Additive => "additive",
+                Severity::Compatible => "compatible",
             };
-            let path = c
-                .rust_path
-                .as_deref()
-                .map(|p| md(&code_span(p)))
+            let path = r.rust_path.map(|p| md(&code_span(p))).unwrap_or_default();
+            let node = r
+                .node
+                .map(|(node, _)| format!(" {} |", md(&code_span(node))))
                 .unwrap_or_default();
             let _ = writeln!(
                 out,
-                "| {severity} | {} | `{}` | {path} | {} |",
-                place(c),
-                c.kind.as_str(),
-                md(&c.message)
+                "| {severity} |{node} {} | `{}` | {path} | {} |",
+                md(&r.place),
+                r.kind,
+                md(r.message)
             );
         }
         out.push('\n');
     }
-    let _ = writeln!(out, "{}", summary(changes));
+    let _ = writeln!(out, "{summary}");
     out
 }
 
@@ -101,34 +182,48 @@ pub(crate) fn md(text: &str) -> String {
 /// One JSON object: `{"old", "new", "changes": [...]}`, pretty-printed with
 /// two-space indentation, keys in a fixed order.
 pub fn json(old: &str, new: &str, changes: &[Change]) -> String {
+    let rows: Vec<Row> = changes.iter().map(Row::of).collect();
+    json_of(old, new, &rows)
+}
+
+/// The JSON object of `rows`: a network change has `node` and `scope`
+/// first and `where` after the sub-index.
+pub(crate) fn json_of(old: &str, new: &str, rows: &[Row]) -> String {
     let mut out = String::new();
     out.push_str("{\n");
     let _ = writeln!(out, "  \"old\": {},", string(old));
     let _ = writeln!(out, "  \"new\": {},", string(new));
-    if changes.is_empty() {
+    if rows.is_empty() {
         out.push_str("  \"changes\": []\n}\n");
         return out;
     }
     out.push_str("  \"changes\": [\n");
-    for (i, c) in changes.iter().enumerate() {
+    for (i, r) in rows.iter().enumerate() {
         out.push_str("    {\n");
-        let _ = writeln!(out, "      \"index\": {},", c.index);
+        if let Some((node, scope)) = r.node {
+            let _ = writeln!(out, "      \"node\": {},", string(node));
+            let _ = writeln!(out, "      \"scope\": {},", string(scope));
+        }
+        let _ = writeln!(out, "      \"index\": {},", r.index);
         let _ = writeln!(
             out,
             "      \"subindex\": {},",
-            c.subindex.map_or("null".to_string(), |s| s.to_string())
+            r.subindex.map_or("null".to_string(), |s| s.to_string())
         );
-        let _ = writeln!(out, "      \"kind\": {},", string(c.kind.as_str()));
-        let _ = writeln!(out, "      \"severity\": {},", string(c.severity.as_str()));
+        if r.node.is_some() {
+            let _ = writeln!(out, "      \"where\": {},", string(&r.place));
+        }
+        let _ = writeln!(out, "      \"kind\": {},", string(r.kind));
+        let _ = writeln!(out, "      \"severity\": {},", string(r.severity.as_str()));
         let _ = writeln!(
             out,
             "      \"rust_path\": {},",
-            c.rust_path.as_deref().map_or("null".to_string(), string)
+            r.rust_path.map_or("null".to_string(), string)
         );
-        let _ = writeln!(out, "      \"old\": {},", value(c.old.as_ref()));
-        let _ = writeln!(out, "      \"new\": {},", value(c.new.as_ref()));
-        let _ = writeln!(out, "      \"message\": {}", string(&c.message));
-        out.push_str(if i + 1 == changes.len() {
+        let _ = writeln!(out, "      \"old\": {},", value(r.old));
+        let _ = writeln!(out, "      \"new\": {},", value(r.new));
+        let _ = writeln!(out, "      \"message\": {}", string(r.message));
+        out.push_str(if i + 1 == rows.len() {
             "    }\n"
         } else {
             "    },\n"

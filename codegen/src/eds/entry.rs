@@ -5,7 +5,24 @@ use super::lower::Lowering;
 use super::number::{self, parse_value};
 use super::sections::{SectionKind, classify};
 use crate::diag::Severity;
-use crate::ir::{Access, DataType, Entry, Literal, ObjectKind, Origin, Value, ValueKind};
+use crate::ir::{
+    Access, DataType, Entry, LimitProblem, Literal, ObjectKind, Origin, Value, ValueKind,
+};
+
+/// The access an AccessType token names (CiA 306: ro, wo, rw, rwr, rww,
+/// const), in any case.
+fn access_type(token: &str) -> Option<Access> {
+    [
+        Access::Ro,
+        Access::Wo,
+        Access::Rw,
+        Access::Rwr,
+        Access::Rww,
+        Access::Const,
+    ]
+    .into_iter()
+    .find(|a| a.as_str().eq_ignore_ascii_case(token))
+}
 
 impl Lowering<'_> {
     /// Reads one entry. `kind` is the object's kind for a VAR/DOMAIN/DEFTYPE
@@ -17,24 +34,13 @@ impl Lowering<'_> {
         section: &Section,
         kind: ObjectKind,
     ) -> Option<Entry> {
-        let fallback = if sub == 0 {
-            format!("Object 0x{index:04X}")
-        } else {
-            format!("Sub-index {sub}")
-        };
-        let name = match section.get("ParameterName").filter(|p| !p.value.is_empty()) {
-            Some(p) => p.value.to_string(),
-            None => {
-                self.report(
-                    Severity::Warning,
-                    "eds::missing-name",
-                    section,
-                    None,
-                    format!("no ParameterName; named `{fallback}`"),
-                );
-                fallback
+        let name = self.name(section, || {
+            if sub == 0 {
+                format!("Object 0x{index:04X}")
+            } else {
+                format!("Sub-index {sub}")
             }
-        };
+        });
         let data_type = match section.get("DataType").filter(|p| !p.value.is_empty()) {
             None if kind == ObjectKind::Domain => DataType::Domain,
             None => {
@@ -96,14 +102,9 @@ impl Lowering<'_> {
                 }
                 access
             }
-            Some(p) => match p.value.trim().to_ascii_lowercase().as_str() {
-                "ro" => Access::Ro,
-                "wo" => Access::Wo,
-                "rw" => Access::Rw,
-                "rwr" => Access::Rwr,
-                "rww" => Access::Rww,
-                "const" => Access::Const,
-                _ => {
+            Some(p) => match access_type(p.value.trim()) {
+                Some(access) => access,
+                None => {
                     self.unknown_access(index, sub, section, p);
                     Access::Ro
                 }
@@ -283,54 +284,28 @@ impl Lowering<'_> {
 
     /// Low limit above high limit, or a default outside the limits.
     fn check_limits(&mut self, section: &Section, entry: &Entry) {
-        let num = |l: &Option<Literal>| match l.as_ref().map(|l| (&l.value, l.plus_node_id)) {
-            Some((Value::Integer(v), false)) => Some(*v as f64),
-            Some((Value::Real(v), false)) => Some(*v),
-            _ => None,
-        };
-        let (low, high, default) = (
-            num(&entry.low_limit),
-            num(&entry.high_limit),
-            num(&entry.default),
-        );
-        if let (Some(lo), Some(hi)) = (low, high)
-            && lo > hi
-        {
-            let p = section.get("LowLimit");
-            self.report(
-                Severity::Warning,
-                "eds::limits",
-                section,
-                p,
+        let text = |l: &Option<Literal>| l.as_ref().map_or(String::new(), |l| l.text.clone());
+        let (key, message) = match entry.limit_problem() {
+            None => return,
+            Some(LimitProblem::LowAboveHigh) => (
+                "LowLimit",
                 format!(
                     "LowLimit {} is above HighLimit {}",
-                    entry.low_limit.as_ref().map_or("", |l| &l.text),
-                    entry.high_limit.as_ref().map_or("", |l| &l.text)
+                    text(&entry.low_limit),
+                    text(&entry.high_limit)
                 ),
-            );
-            return;
-        }
-        if let Some(d) = default {
-            let below = low.is_some_and(|lo| d < lo);
-            let above = high.is_some_and(|hi| d > hi);
-            if below || above {
-                let p = section.get("DefaultValue");
-                let which = if below {
+            ),
+            Some(problem) => {
+                let which = if problem == LimitProblem::DefaultBelowLow {
                     "below LowLimit"
                 } else {
                     "above HighLimit"
                 };
-                self.report(
-                    Severity::Warning,
-                    "eds::limits",
-                    section,
-                    p,
-                    format!(
-                        "DefaultValue {} is {which}",
-                        entry.default.as_ref().map_or("", |l| &l.text)
-                    ),
-                );
+                let message = format!("DefaultValue {} is {which}", text(&entry.default));
+                ("DefaultValue", message)
             }
-        }
+        };
+        let p = section.get(key);
+        self.report(Severity::Warning, "eds::limits", section, p, message);
     }
 }

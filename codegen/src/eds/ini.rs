@@ -15,6 +15,8 @@
 //!   (warning).
 
 use std::collections::HashMap;
+use std::collections::hash_map::Entry;
+use std::hash::{Hash, Hasher};
 use std::ops::Range;
 
 use crate::diag::{Diagnostic, Diagnostics, Location, Severity};
@@ -31,6 +33,8 @@ pub struct Property<'a> {
     pub value_span: Range<usize>,
     /// Byte range of the whole line without its end-of-line.
     pub line_span: Range<usize>,
+    /// [`fold`] of the key: a key is compared in full only where this matches.
+    fold: u64,
 }
 
 /// One `[section]` with its properties.
@@ -41,35 +45,82 @@ pub struct Section<'a> {
     pub line: u32,
     pub header_span: Range<usize>,
     pub properties: Vec<Property<'a>>,
-    /// Lowercase key → position in `properties`, once the section has more
+    /// Key (any case) → position in `properties`, once the section has more
     /// than [`SCAN_LIMIT`] keys: lookups stay constant time in sections of
     /// any size (a list of 200,000 objects), and small sections (every
-    /// object section) pay no allocation per key.
-    index: Option<HashMap<String, usize>>,
+    /// object section) are scanned by [`Property::fold`].
+    index: Option<HashMap<NoCase<'a>, usize>>,
 }
 
 /// Sections with at most this many keys are searched by a scan.
 const SCAN_LIMIT: usize = 16;
 
+/// A name compared and hashed without regard to ASCII case, borrowed from
+/// the text (no lowercase copy).
+#[derive(Debug, Clone, Copy)]
+struct NoCase<'a>(&'a str);
+
+impl PartialEq for NoCase<'_> {
+    fn eq(&self, other: &Self) -> bool {
+        same_key(self.0, other.0)
+    }
+}
+
+impl Eq for NoCase<'_> {}
+
+impl Hash for NoCase<'_> {
+    fn hash<H: Hasher>(&self, state: &mut H) {
+        let mut buf = [0u8; 32];
+        for chunk in self.0.as_bytes().chunks(buf.len()) {
+            let lower = &mut buf[..chunk.len()];
+            lower.copy_from_slice(chunk);
+            lower.make_ascii_lowercase();
+            state.write(lower);
+        }
+        state.write_u8(0xFF);
+    }
+}
+
+/// Whether two keys are equal without regard to ASCII case (most files
+/// write a key as CiA 306 does: compared byte for byte first).
+fn same_key(a: &str, b: &str) -> bool {
+    a == b || a.eq_ignore_ascii_case(b)
+}
+
+/// A summary of a key, equal for keys equal without regard to ASCII case
+/// (a filter: keys of equal summaries are compared in full): its length
+/// and its first seven bytes with the ASCII case bit (0x20) set.
+#[inline(always)]
+fn fold(key: &str) -> u64 {
+    let bytes = key.as_bytes();
+    let mut word = (bytes.len() as u64) << 56;
+    for (i, &b) in bytes.iter().take(7).enumerate() {
+        word |= u64::from(b | 0x20) << (8 * i);
+    }
+    word
+}
+
 impl<'a> Section<'a> {
-    fn new(name: &'a str, line: u32, header_span: Range<usize>) -> Section<'a> {
+    /// A section without properties, room made for `keys` of them.
+    fn new(name: &'a str, line: u32, header_span: Range<usize>, keys: usize) -> Section<'a> {
         Section {
             name,
             line,
             header_span,
-            properties: Vec::new(),
+            properties: Vec::with_capacity(keys),
             index: None,
         }
     }
 
-    /// The position in `properties` of the key `key`, without regard to case.
-    fn position(&self, key: &str) -> Option<usize> {
+    /// The position in `properties` of the key `key` (whose [`fold`] is
+    /// `folded`), without regard to case.
+    fn position(&self, key: &str, folded: u64) -> Option<usize> {
         match &self.index {
-            Some(index) => index.get(&key.to_ascii_lowercase()).copied(),
+            Some(index) => index.get(&NoCase(key)).copied(),
             None => self
                 .properties
                 .iter()
-                .position(|p| p.key.eq_ignore_ascii_case(key)),
+                .position(|p| p.fold == folded && same_key(p.key, key)),
         }
     }
 
@@ -77,14 +128,14 @@ impl<'a> Section<'a> {
     fn push(&mut self, property: Property<'a>) {
         let position = self.properties.len();
         if let Some(index) = &mut self.index {
-            index.insert(property.key.to_ascii_lowercase(), position);
+            index.insert(NoCase(property.key), position);
         } else if position == SCAN_LIMIT {
             let index = self
                 .properties
                 .iter()
                 .chain([&property])
                 .enumerate()
-                .map(|(i, p)| (p.key.to_ascii_lowercase(), i))
+                .map(|(i, p)| (NoCase(p.key), i))
                 .collect();
             self.index = Some(index);
         }
@@ -92,8 +143,10 @@ impl<'a> Section<'a> {
     }
 
     /// The property whose key matches `key` without regard to case.
+    #[inline(always)]
     pub fn get(&self, key: &str) -> Option<&Property<'a>> {
-        self.position(key).map(|i| &self.properties[i])
+        // Inlined, so that the fold of a constant key is a constant.
+        self.position(key, fold(key)).map(|i| &self.properties[i])
     }
 }
 
@@ -103,7 +156,7 @@ pub struct Document<'a> {
     pub file: String,
     pub text: &'a str,
     pub sections: Vec<Section<'a>>,
-    by_name: HashMap<String, usize>,
+    by_name: HashMap<NoCase<'a>, usize>,
 }
 
 impl<'a> Document<'a> {
@@ -115,9 +168,7 @@ impl<'a> Document<'a> {
 
     /// The section whose name matches `name` without regard to case.
     pub fn section(&self, name: &str) -> Option<&Section<'a>> {
-        self.by_name
-            .get(&name.to_ascii_lowercase())
-            .map(|&i| &self.sections[i])
+        self.by_name.get(&NoCase(name)).map(|&i| &self.sections[i])
     }
 }
 
@@ -145,10 +196,19 @@ fn is_free_text_key(key: &str) -> bool {
 /// CR line endings alone (old Mac OS) become line breaks, as in
 /// python-canopen's reader (Python's universal newlines), with a warning.
 pub fn decode(file: &str, bytes: &[u8], diags: &mut Diagnostics) -> String {
-    let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
-    let text = match std::str::from_utf8(bytes) {
-        Ok(text) => text.to_string(),
+    decode_owned(file, bytes.to_vec(), diags)
+}
+
+/// [`decode`] of bytes the caller hands over: UTF-8 text keeps them (no copy).
+pub(super) fn decode_owned(file: &str, mut bytes: Vec<u8>, diags: &mut Diagnostics) -> String {
+    const BOM: &[u8] = b"\xEF\xBB\xBF";
+    if bytes.starts_with(BOM) {
+        bytes.drain(..BOM.len());
+    }
+    let text = match String::from_utf8(bytes) {
+        Ok(text) => text,
         Err(err) => {
+            let (bytes, err) = (err.as_bytes(), err.utf8_error());
             // `decode` follows a UTF-16 byte-order mark, else reads Windows-1252.
             let (text, encoding) = super::legacy::decode(bytes);
             let (line, message) = if encoding == super::legacy::Encoding::Windows1252 {
@@ -209,18 +269,35 @@ fn warn_whole_line(
 ) {
     let start = line_start(text, line);
     let end = text[start..].find('\n').map_or(text.len(), |n| start + n);
-    diags.push(Diagnostic {
+    let mut warning = warning(file, code, line, start..end.max(start), None, None, message);
+    warning.notes.push(note.to_string());
+    diags.push(warning);
+}
+
+/// A warning of the INI layer at `line` (`span` of the text), in `section`
+/// at `key` where those are known.
+fn warning(
+    file: &str,
+    code: &'static str,
+    line: u32,
+    span: Range<usize>,
+    section: Option<&str>,
+    key: Option<&str>,
+    message: String,
+) -> Diagnostic {
+    Diagnostic {
         severity: Severity::Warning,
         code,
         file: file.to_string(),
         location: Location {
             line: Some(line),
-            span: Some(start..end.max(start)),
-            ..Location::default()
+            span: Some(span),
+            section: section.map(str::to_string),
+            key: key.map(str::to_string),
         },
         message,
-        notes: vec![note.to_string()],
-    });
+        notes: Vec::new(),
+    }
 }
 
 fn line_start(text: &str, line: u32) -> usize {
@@ -234,8 +311,11 @@ fn line_start(text: &str, line: u32) -> usize {
 
 /// Splits decoded text into sections. Problems of the INI layer are pushed to `diags`.
 pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document<'a> {
-    let mut sections: Vec<Section<'a>> = Vec::new();
-    let mut by_name: HashMap<String, usize> = HashMap::new();
+    // Room for the sections of a typical file of this size (a section
+    // of a real file is 140 bytes on average), up to a bound.
+    let headers = (text.len() / 128).min(1 << 16);
+    let mut sections: Vec<Section<'a>> = Vec::with_capacity(headers);
+    let mut by_name: HashMap<NoCase<'a>, usize> = HashMap::with_capacity(headers);
     // Index into `sections` of the section that receives properties now.
     let mut current: Option<usize> = None;
     let warn = |diags: &mut Diagnostics,
@@ -245,35 +325,21 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                 section: Option<&str>,
                 key: Option<&str>,
                 message: String| {
-        diags.push(Diagnostic {
-            severity: Severity::Warning,
-            code,
-            file: file.to_string(),
-            location: Location {
-                line: Some(line),
-                span: Some(span),
-                section: section.map(str::to_string),
-                key: key.map(str::to_string),
-            },
-            message,
-            notes: Vec::new(),
-        })
+        diags.push(warning(file, code, line, span, section, key, message))
     };
 
-    let mut offset = 0usize;
-    for (n, raw_line) in text.split('\n').enumerate() {
+    for (n, (line_offset, raw_line)) in lines(text).enumerate() {
         let line_no = n as u32 + 1;
-        let line_offset = offset;
-        offset += raw_line.len() + 1;
         let content = raw_line.strip_suffix('\r').unwrap_or(raw_line);
-        let lead = content.len() - content.trim_start().len();
-        let trimmed = content.trim();
+        let trimmed = trim_start(content);
+        let lead = content.len() - trimmed.len();
+        let trimmed = trim_end(trimmed);
         let line_span = line_offset + lead..line_offset + lead + trimmed.len();
         if trimmed.is_empty() || trimmed.starts_with(';') || trimmed.starts_with('#') {
             continue;
         }
         if let Some(rest) = trimmed.strip_prefix('[') {
-            let Some(close) = rest.find(']') else {
+            let Some(close) = rest.bytes().position(|b| b == b']') else {
                 warn(
                     diags,
                     "eds::bad-section-header",
@@ -286,8 +352,8 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                 current = None;
                 continue;
             };
-            let name = rest[..close].trim();
-            let after = rest[close + 1..].trim();
+            let name = trim(&rest[..close]);
+            let after = trim(&rest[close + 1..]);
             if !after.is_empty() && !after.starts_with(';') && !after.starts_with('#') {
                 warn(
                     diags,
@@ -299,25 +365,31 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
                     format!("text after the section header is ignored: `{after}`"),
                 );
             }
-            let key = name.to_ascii_lowercase();
-            if let Some(&existing) = by_name.get(&key) {
-                let first_line = sections[existing].line;
-                warn(
-                    diags,
-                    "eds::duplicate-section",
-                    line_no,
-                    line_span,
-                    Some(name),
-                    None,
-                    format!(
-                        "section [{name}] appears again (first at line {first_line}); its keys are merged into the first, later keys win"
-                    ),
-                );
-                current = Some(existing);
-            } else {
-                by_name.insert(key, sections.len());
-                current = Some(sections.len());
-                sections.push(Section::new(name, line_no, line_span));
+            match by_name.entry(NoCase(name)) {
+                Entry::Occupied(first) => {
+                    let existing = *first.get();
+                    let first_line = sections[existing].line;
+                    warn(
+                        diags,
+                        "eds::duplicate-section",
+                        line_no,
+                        line_span,
+                        Some(name),
+                        None,
+                        format!(
+                            "section [{name}] appears again (first at line {first_line}); its keys are merged into the first, later keys win"
+                        ),
+                    );
+                    current = Some(existing);
+                }
+                Entry::Vacant(vacant) => {
+                    vacant.insert(sections.len());
+                    current = Some(sections.len());
+                    // Sections of a file are alike: room for as many keys
+                    // as the one before had.
+                    let keys = sections.last().map_or(0, |s| s.properties.len().min(32));
+                    sections.push(Section::new(name, line_no, line_span, keys));
+                }
             }
             continue;
         }
@@ -333,34 +405,30 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
             );
             continue;
         };
-        let Some(eq) = trimmed.find('=') else {
-            warn(
-                diags,
-                "eds::not-key-value",
-                line_no,
-                line_span,
-                Some(sections[section_index].name),
-                None,
-                "a line without `=` is ignored".to_string(),
-            );
-            continue;
+        let eq = trimmed.bytes().position(|b| b == b'=');
+        let (eq, key) = match eq.map(|eq| (eq, trim(&trimmed[..eq]))) {
+            Some((eq, key)) if !key.is_empty() => (eq, key),
+            other => {
+                let message = match other {
+                    None => "a line without `=` is ignored",
+                    Some(_) => "a line with an empty key is ignored",
+                };
+                warn(
+                    diags,
+                    "eds::not-key-value",
+                    line_no,
+                    line_span,
+                    Some(sections[section_index].name),
+                    None,
+                    message.to_string(),
+                );
+                continue;
+            }
         };
-        let key = trimmed[..eq].trim();
-        if key.is_empty() {
-            warn(
-                diags,
-                "eds::not-key-value",
-                line_no,
-                line_span,
-                Some(sections[section_index].name),
-                None,
-                "a line with an empty key is ignored".to_string(),
-            );
-            continue;
-        }
         let raw_value = &trimmed[eq + 1..];
-        let value_lead = raw_value.len() - raw_value.trim_start().len();
-        let mut value = raw_value.trim();
+        let mut value = trim_start(raw_value);
+        let value_lead = raw_value.len() - value.len();
+        value = trim_end(value);
         if !is_free_text_key(key) {
             value = strip_inline_comment(value);
         }
@@ -370,15 +438,17 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
         } else {
             value_start..value_start + value.len()
         };
+        let folded = fold(key);
         let property = Property {
             key,
             value,
             line: line_no,
             value_span,
             line_span: line_span.clone(),
+            fold: folded,
         };
         let section = &mut sections[section_index];
-        if let Some(pos) = section.position(key) {
+        if let Some(pos) = section.position(key, folded) {
             let first_line = section.properties[pos].line;
             section.properties[pos] = property;
             warn(
@@ -400,6 +470,53 @@ pub fn parse<'a>(file: &str, text: &'a str, diags: &mut Diagnostics) -> Document
         sections,
         by_name,
     }
+}
+
+/// The lines of `text` (split at LF, as `str::split`) with the byte offset
+/// each starts at.
+fn lines(text: &str) -> impl Iterator<Item = (usize, &str)> {
+    let mut start = Some(0);
+    std::iter::from_fn(move || {
+        let from = start?;
+        let rest = &text[from..];
+        let len = rest.bytes().position(|b| b == b'\n');
+        start = len.map(|len| from + len + 1);
+        Some((from, &rest[..len.unwrap_or(rest.len())]))
+    })
+}
+
+/// Whether `b` is ASCII white space as [`char::is_whitespace`] has it
+/// (tab, LF, vertical tab, form feed, CR, space).
+fn is_ascii_space(b: u8) -> bool {
+    matches!(b, b'\t'..=b'\r' | b' ')
+}
+
+/// [`str::trim_start`], skipping ASCII white space byte by byte (the
+/// Unicode rule decides only where a non-ASCII character follows).
+fn trim_start(s: &str) -> &str {
+    let skip = s.bytes().take_while(|&b| is_ascii_space(b)).count();
+    let rest = &s[skip..];
+    if rest.as_bytes().first().is_some_and(|b| !b.is_ascii()) {
+        rest.trim_start()
+    } else {
+        rest
+    }
+}
+
+/// [`str::trim_end`], ASCII white space byte by byte as [`trim_start`].
+fn trim_end(s: &str) -> &str {
+    let skip = s.bytes().rev().take_while(|&b| is_ascii_space(b)).count();
+    let rest = &s[..s.len() - skip];
+    if rest.as_bytes().last().is_some_and(|b| !b.is_ascii()) {
+        rest.trim_end()
+    } else {
+        rest
+    }
+}
+
+/// [`str::trim`], ASCII white space byte by byte as [`trim_start`].
+fn trim(s: &str) -> &str {
+    trim_end(trim_start(s))
 }
 
 /// Cuts a value at the first `;` that follows white space.

@@ -77,16 +77,6 @@ impl<'a> Lowering<'a> {
         self.report(Severity::Warning, code, section, prop, message);
     }
 
-    pub(super) fn error(
-        &mut self,
-        code: &'static str,
-        section: &Section,
-        prop: Option<&Property>,
-        message: String,
-    ) {
-        self.report(Severity::Error, code, section, prop, message);
-    }
-
     pub(super) fn origin(&self, line: u32) -> Origin {
         Origin {
             file: self.doc.file.clone(),

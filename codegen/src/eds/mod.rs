@@ -25,7 +25,7 @@ pub fn read_file(path: &Path, options: &Options) -> Loaded {
 
 /// Reads EDS/DCF content; `file` names it in diagnostics and origins.
 pub fn read_bytes(file: &str, bytes: &[u8], options: &Options) -> Loaded {
-    read_bytes_unfinished(file, bytes).finish(options)
+    read_bytes_unfinished(file, bytes.to_vec()).finish(options)
 }
 
 /// [`read_file`] before levels and strictness are applied (but with the
@@ -33,16 +33,15 @@ pub fn read_bytes(file: &str, bytes: &[u8], options: &Options) -> Loaded {
 pub(crate) fn read_file_unfinished(path: &Path, options: &Options) -> Loaded {
     let name = path.display().to_string();
     match Loaded::read_bounded(path, options) {
-        Ok(bytes) => read_bytes_unfinished(&name, &bytes),
+        Ok(bytes) => read_bytes_unfinished(&name, bytes),
         Err(refused) => *refused,
     }
     .read_first(path)
 }
 
-fn read_bytes_unfinished(file: &str, bytes: &[u8]) -> Loaded {
+fn read_bytes_unfinished(file: &str, bytes: Vec<u8>) -> Loaded {
     let mut diagnostics = Diagnostics::new();
-    let text = ini::decode(file, bytes, &mut diagnostics);
-    diagnostics.add_source(file, &text);
+    let text = ini::decode_owned(file, bytes, &mut diagnostics);
     let doc = ini::parse(file, &text, &mut diagnostics);
     let device = lower::Lowering {
         doc: &doc,
@@ -53,6 +52,9 @@ fn read_bytes_unfinished(file: &str, bytes: &[u8]) -> Loaded {
     if device.objects.is_empty() && !looks_like_eds(&doc) {
         return not_a_device_file(file, device, diagnostics.len());
     }
+    drop(doc);
+    // The text the diagnostics point into, moved there once nothing borrows it.
+    diagnostics.add_source(file, text);
     if device.objects.is_empty() {
         diagnostics.push(Diagnostic {
             severity: Severity::Error,

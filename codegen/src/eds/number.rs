@@ -1,15 +1,35 @@
 //! Literals of CiA 306: integers (decimal, `0x` hex, leading-`0` octal),
 //! `$NODEID` formulas, REAL values (decimal or hex bit pattern), hex strings.
 
+use std::borrow::Cow;
+
 use crate::ir::{DataType, Literal, Value, ValueKind, node_formula_problem};
 
 /// Why a literal could not be read.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct LiteralError(pub String);
 
+/// `text` without its white space (borrowed when it has none).
+fn without_space(text: &str) -> Cow<'_, str> {
+    if text.bytes().all(|b| b.is_ascii_graphic()) {
+        Cow::Borrowed(text)
+    } else {
+        Cow::Owned(text.chars().filter(|c| !c.is_whitespace()).collect())
+    }
+}
+
+/// The byte position of the first `$NODEID` in `text`, in any case.
+fn find_node_id(text: &str) -> Option<usize> {
+    const NODE_ID: &str = "$NODEID";
+    text.match_indices('$').map(|(pos, _)| pos).find(|&pos| {
+        text.get(pos..pos + NODE_ID.len())
+            .is_some_and(|s| s.eq_ignore_ascii_case(NODE_ID))
+    })
+}
+
 /// Parses an unsigned or signed integer: `123`, `-5`, `0x1A`, `017` (octal), `0`.
 pub fn parse_int(text: &str) -> Result<i128, LiteralError> {
-    let t: String = text.chars().filter(|c| !c.is_whitespace()).collect();
+    let t = without_space(text);
     let (negative, digits) = match t.strip_prefix('-') {
         Some(rest) => (true, rest),
         None => (false, t.strip_prefix('+').unwrap_or(&t)),
@@ -45,14 +65,13 @@ pub fn parse_int(text: &str) -> Result<i128, LiteralError> {
 /// Parses an integer that may contain `$NODEID` (`$NODEID+0x180`, `0x180 + $NODEID`).
 /// Returns the constant part and whether the node id is added.
 pub fn parse_int_expr(text: &str) -> Result<(i128, bool), LiteralError> {
-    let compact: String = text.chars().filter(|c| !c.is_whitespace()).collect();
-    let upper = compact.to_ascii_uppercase();
-    let Some(pos) = upper.find("$NODEID") else {
+    let compact = without_space(text);
+    let Some(pos) = find_node_id(&compact) else {
         return parse_int(&compact).map(|v| (v, false));
     };
     let before = &compact[..pos];
     let after = &compact[pos + "$NODEID".len()..];
-    if upper[pos + 1..].contains("$NODEID") {
+    if find_node_id(&compact[pos + 1..]).is_some() {
         return Err(LiteralError(format!(
             "`{text}` names $NODEID more than once"
         )));
@@ -86,7 +105,7 @@ pub fn parse_int_expr(text: &str) -> Result<(i128, bool), LiteralError> {
 
 /// Parses a hex byte string such as `0102AB` or `01 02 AB`.
 pub fn parse_hex_bytes(text: &str) -> Result<Vec<u8>, LiteralError> {
-    let digits: String = text.chars().filter(|c| !c.is_whitespace()).collect();
+    let digits = without_space(text);
     let digits = digits
         .strip_prefix("0x")
         .or_else(|| digits.strip_prefix("0X"))

@@ -6,6 +6,7 @@ use std::collections::BTreeMap;
 use super::ini::Section;
 use super::lower::Lowering;
 use super::number;
+use crate::diag::Severity;
 use crate::ir::{Entry, Object, ObjectKind, Origin};
 
 impl Lowering<'_> {
@@ -17,7 +18,7 @@ impl Lowering<'_> {
         names: Option<&Section>,
         values: Option<&Section>,
     ) -> Option<Object> {
-        let name = self.name(section, format!("Object 0x{index:04X}"));
+        let name = self.name(section, || format!("Object 0x{index:04X}"));
         let kind = match section.get("ObjectType") {
             None => ObjectKind::Var,
             Some(p) => match number::parse_int(p.value) {
@@ -28,11 +29,12 @@ impl Lowering<'_> {
                 Ok(0x8) => ObjectKind::Array,
                 Ok(0x9) => ObjectKind::Record,
                 Ok(other) => {
-                    self.error("eds::bad-object-type", section, Some(p), format!("object type {other:#x} is not one of 0x2 DOMAIN, 0x5 DEFTYPE, 0x6 DEFSTRUCT, 0x7 VAR, 0x8 ARRAY, 0x9 RECORD; the object is left out"));
+                    self.report(Severity::Error, "eds::bad-object-type", section, Some(p), format!("object type {other:#x} is not one of 0x2 DOMAIN, 0x5 DEFTYPE, 0x6 DEFSTRUCT, 0x7 VAR, 0x8 ARRAY, 0x9 RECORD; the object is left out"));
                     return None;
                 }
                 Err(e) => {
-                    self.error(
+                    self.report(
+                        Severity::Error,
                         "eds::bad-object-type",
                         section,
                         Some(p),
@@ -65,7 +67,7 @@ impl Lowering<'_> {
                 self.warn("eds::orphan-sub", sub, None, format!("object 0x{index:04X} is a {kind:?}, which has no sub-objects; the section is ignored"));
             }
             if let Some(entry) = self.entry(index, 0, section, kind) {
-                entries.insert(0, entry);
+                entries.insert(0, Box::new(entry));
             }
         } else {
             if let Some(n) = compact {
@@ -123,7 +125,7 @@ impl Lowering<'_> {
             }
             for (sub, sub_section) in subs {
                 if let Some(entry) = self.entry(index, sub, sub_section, ObjectKind::Var) {
-                    entries.insert(sub, entry);
+                    entries.insert(sub, Box::new(entry));
                 }
             }
         }
@@ -131,7 +133,7 @@ impl Lowering<'_> {
             index,
             name,
             kind,
-            entries: Object::boxed_entries(entries),
+            entries,
             obj_flags,
             denotation,
             compact_sub_obj: compact,
@@ -140,10 +142,13 @@ impl Lowering<'_> {
         })
     }
 
-    pub(super) fn name(&mut self, section: &Section, fallback: String) -> String {
+    /// The section's ParameterName; when it has none (or an empty one), a
+    /// warning and the name `fallback` gives.
+    pub(super) fn name(&mut self, section: &Section, fallback: impl FnOnce() -> String) -> String {
         match Self::text(Some(section), "ParameterName") {
             Some(name) => name,
             None => {
+                let fallback = fallback();
                 self.warn(
                     "eds::missing-name",
                     section,
@@ -164,10 +169,10 @@ impl Lowering<'_> {
         n: u8,
         names: Option<&Section>,
         values: Option<&Section>,
-    ) -> BTreeMap<u8, Entry> {
+    ) -> BTreeMap<u8, Box<Entry>> {
         let mut entries = BTreeMap::new();
         let origin = self.origin(section.line);
-        entries.insert(0, Entry::highest_subindex(n, origin));
+        entries.insert(0, Box::new(Entry::highest_subindex(n, origin)));
         let Some(template) = self.entry(index, 1, section, ObjectKind::Var) else {
             return entries;
         };
@@ -177,14 +182,14 @@ impl Lowering<'_> {
                 .filter(|p| !p.value.is_empty())
         };
         for sub in 1..=n {
-            let mut entry = template.clone();
+            let mut entry = Box::new(template.clone());
             entry.subindex = sub;
-            entry.name = match name_of(sub) {
-                Some(p) => p.value.to_string(),
-                None => format!("{name}{sub}"),
-            };
-            if let Some(p) = name_of(sub) {
-                entry.origin = self.origin(p.line);
+            match name_of(sub) {
+                Some(p) => {
+                    entry.name = p.value.to_string();
+                    entry.origin = self.origin(p.line);
+                }
+                None => entry.name = format!("{name}{sub}"),
             }
             entries.insert(sub, entry);
         }

@@ -46,40 +46,44 @@ fn hex4(s: &str) -> Option<u16> {
 /// Classifies a section name (as written; case does not matter).
 pub fn classify(name: &str) -> SectionKind<'_> {
     let name = name.trim();
-    let lower = name.to_ascii_lowercase();
-    if let Some(index) = hex4(&lower) {
+    if let Some(index) = hex4(name) {
         return SectionKind::Object(index);
     }
-    if lower.len() > 4
-        && lower.is_char_boundary(4)
-        && let Some(index) = hex4(&lower[..4])
+    if name.len() > 4
+        && name.is_char_boundary(4)
+        && let Some(index) = hex4(&name[..4])
     {
-        let rest = &lower[4..];
-        if let Some(sub) = rest.strip_prefix("sub") {
+        let rest = &name[4..];
+        if let Some(sub) = strip_prefix_no_case(rest, "sub") {
             if !sub.is_empty() && sub.bytes().all(|b| b.is_ascii_hexdigit()) {
-                // ASCII lowercasing keeps byte offsets: the digits as written.
-                return SectionKind::Sub(index, &name[name.len() - sub.len()..]);
+                return SectionKind::Sub(index, sub);
             }
             return SectionKind::Unknown;
         }
-        match rest {
-            "name" => return SectionKind::CompactNames(index),
-            "value" => return SectionKind::CompactValues(index),
-            _ => {}
+        if rest.eq_ignore_ascii_case("name") {
+            return SectionKind::CompactNames(index);
+        }
+        if rest.eq_ignore_ascii_case("value") {
+            return SectionKind::CompactValues(index);
         }
     }
-    let is_tool = lower
-        .strip_prefix("tool")
-        .is_some_and(|n| n.bytes().all(|b| b.is_ascii_digit()));
+    let is_tool =
+        strip_prefix_no_case(name, "tool").is_some_and(|n| n.bytes().all(|b| b.is_ascii_digit()));
     // Modular devices (CiA 306 §4.6): [M1ModuleInfo], [M1FixedObjects], [M2SubExt6000] …
-    let is_module = lower
-        .strip_prefix('m')
+    let is_module = strip_prefix_no_case(name, "m")
         .is_some_and(|r| r.starts_with(|c: char| c.is_ascii_digit()));
-    if KNOWN.contains(&lower.as_str()) || is_tool || is_module {
+    if KNOWN.iter().any(|k| k.eq_ignore_ascii_case(name)) || is_tool || is_module {
         SectionKind::Known
     } else {
         SectionKind::Unknown
     }
+}
+
+/// `s` without `prefix` (lowercase ASCII), matched without regard to case.
+fn strip_prefix_no_case<'s>(s: &'s str, prefix: &str) -> Option<&'s str> {
+    s.get(..prefix.len())
+        .filter(|head| head.eq_ignore_ascii_case(prefix))
+        .map(|_| &s[prefix.len()..])
 }
 
 /// The sub-index of a sub-section name by CiA 306: 1 or 2 hex digits.

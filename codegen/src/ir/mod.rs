@@ -313,6 +313,43 @@ fn semantics_is_empty(semantics: &Semantics) -> bool {
     semantics.is_empty()
 }
 
+/// How an entry's limits and default disagree (both readers report it).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LimitProblem {
+    /// The low limit is above the high limit.
+    LowAboveHigh,
+    /// The default is below the low limit.
+    DefaultBelowLow,
+    /// The default is above the high limit.
+    DefaultAboveHigh,
+}
+
+impl Entry {
+    /// The low limit above the high limit, else the default outside them;
+    /// only numbers are compared (not `$NODEID` formulas, not text).
+    pub fn limit_problem(&self) -> Option<LimitProblem> {
+        let num = |l: &Option<Literal>| match l.as_ref().map(|l| (&l.value, l.plus_node_id)) {
+            Some((Value::Integer(v), false)) => Some(*v as f64),
+            Some((Value::Real(v), false)) => Some(*v),
+            _ => None,
+        };
+        let (low, high) = (num(&self.low_limit), num(&self.high_limit));
+        if let (Some(lo), Some(hi)) = (low, high)
+            && lo > hi
+        {
+            return Some(LimitProblem::LowAboveHigh);
+        }
+        let default = num(&self.default)?;
+        if low.is_some_and(|lo| default < lo) {
+            Some(LimitProblem::DefaultBelowLow)
+        } else if high.is_some_and(|hi| default > hi) {
+            Some(LimitProblem::DefaultAboveHigh)
+        } else {
+            None
+        }
+    }
+}
+
 impl Object {
     /// Entries by sub-index, each boxed as [`Object::entries`] holds them.
     pub fn boxed_entries(entries: BTreeMap<u8, Entry>) -> BTreeMap<u8, Box<Entry>> {

@@ -94,6 +94,20 @@ pub struct Pdo {
     pub spot: Option<Spot>,
 }
 
+/// A PDO of transmission type 1 mapping `(index, sub-index, bits)`, for tests.
+#[cfg(test)]
+pub(crate) fn test_pdo(number: u16, cob_id: u32, mapping: &[(u16, u8, u8)]) -> Pdo {
+    let mapping = mapping
+        .iter()
+        .map(|&(index, subindex, bits)| MappedObject {
+            index,
+            subindex,
+            bits,
+        })
+        .collect();
+    Pdo::new(number, cob_id, 1, mapping)
+}
+
 impl Pdo {
     /// A PDO with this number, COB-ID entry value, transmission type and
     /// mapping; no inhibit time, timers or SYNC start value, not from the

@@ -250,13 +250,19 @@ const ERROR_REGISTER_BITS: &[StdBit] = &[
     bit(7, "manufacturer specific", None),
 ];
 
+/// Bits 0 to 28 of every COB-ID: the CAN-ID.
+const CAN_ID: StdBit = field(0, 29, "CAN-ID", None);
+
+/// Bit 29 of every COB-ID: an 11-bit or a 29-bit CAN-ID.
+const EXTENDED_FRAME: StdBit = bit(
+    29,
+    "extended frame",
+    Some("1 = 29-bit CAN-ID, 0 = 11-bit (bits 11 to 28 zero)"),
+);
+
 const COB_ID_SYNC_BITS: &[StdBit] = &[
-    field(0, 29, "CAN-ID", None),
-    bit(
-        29,
-        "extended frame",
-        Some("1 = 29-bit CAN-ID, 0 = 11-bit (bits 11 to 28 zero)"),
-    ),
+    CAN_ID,
+    EXTENDED_FRAME,
     bit(
         30,
         "generate",
@@ -265,12 +271,8 @@ const COB_ID_SYNC_BITS: &[StdBit] = &[
 ];
 
 const COB_ID_EMCY_BITS: &[StdBit] = &[
-    field(0, 29, "CAN-ID", None),
-    bit(
-        29,
-        "extended frame",
-        Some("1 = 29-bit CAN-ID, 0 = 11-bit (bits 11 to 28 zero)"),
-    ),
+    CAN_ID,
+    EXTENDED_FRAME,
     bit(
         31,
         "not valid",
@@ -279,12 +281,8 @@ const COB_ID_EMCY_BITS: &[StdBit] = &[
 ];
 
 const PDO_COB_ID_BITS: &[StdBit] = &[
-    field(0, 29, "CAN-ID", None),
-    bit(
-        29,
-        "extended frame",
-        Some("1 = 29-bit CAN-ID, 0 = 11-bit (bits 11 to 28 zero)"),
-    ),
+    CAN_ID,
+    EXTENDED_FRAME,
     bit(
         30,
         "no RTR",

@@ -14,7 +14,7 @@ use super::{At, Ctx, place};
 use crate::diag::Severity;
 use crate::eds::number;
 use crate::r#gen::rust::naming::Case;
-use crate::ir::{Access, DataType, Device, Entry, Literal, Object, ObjectKind, Value};
+use crate::ir::{Access, DataType, Device, Entry, LimitProblem, Literal, Object, ObjectKind};
 
 /// Stage 4: adds one object of `objects`.
 pub(super) fn add(ctx: &mut Ctx, device: &mut Device, def: &Spanned<EntryDef>) {
@@ -363,54 +363,37 @@ pub(super) fn literal(
 /// `min` above `max`, or a default outside them; reported at the key that
 /// `def` gives (else at `def`).
 fn check_limits(ctx: &mut Ctx, entry: &Entry, def: &Spanned<EntryDef>, here: &str) {
-    let num = |l: &Option<Literal>| match l.as_ref().map(|l| (&l.value, l.plus_node_id)) {
-        Some((Value::Integer(v), false)) => Some(*v as f64),
-        Some((Value::Real(v), false)) => Some(*v),
-        _ => None,
-    };
     let text = |l: &Option<Literal>| l.as_ref().map_or(String::new(), |l| l.text.clone());
     let at_key = |t: &Option<Text>| t.as_ref().map_or(At::of(def), At::of);
-    let (low, high, default) = (
-        num(&entry.low_limit),
-        num(&entry.high_limit),
-        num(&entry.default),
-    );
-    if let (Some(lo), Some(hi)) = (low, high)
-        && lo > hi
-    {
-        ctx.error(
-            "table::limits",
-            at_key(&def.value.min),
-            here,
+    let (key, message) = match entry.limit_problem() {
+        None => return,
+        Some(LimitProblem::LowAboveHigh) => (
             "min",
             format!(
                 "min {} is above max {}",
                 text(&entry.low_limit),
                 text(&entry.high_limit)
             ),
-        );
-        return;
-    }
-    if let Some(d) = default
-        && (low.is_some_and(|lo| d < lo) || high.is_some_and(|hi| d > hi))
-    {
-        let bound = |l: &Option<Literal>| match l {
-            Some(l) => l.text.clone(),
-            None => "…".into(),
-        };
-        ctx.error(
-            "table::limits",
-            at_key(&def.value.default),
-            here,
-            "default",
-            format!(
+        ),
+        Some(LimitProblem::DefaultBelowLow | LimitProblem::DefaultAboveHigh) => {
+            let bound = |l: &Option<Literal>| match l {
+                Some(l) => l.text.clone(),
+                None => "…".into(),
+            };
+            let message = format!(
                 "default {} is outside min..max ({}..{})",
                 text(&entry.default),
                 bound(&entry.low_limit),
                 bound(&entry.high_limit)
-            ),
-        );
-    }
+            );
+            ("default", message)
+        }
+    };
+    let at = match key {
+        "min" => at_key(&def.value.min),
+        _ => at_key(&def.value.default),
+    };
+    ctx.error("table::limits", at, here, key, message);
 }
 
 /// Stage 2: removes an object or one sub-entry of the base.

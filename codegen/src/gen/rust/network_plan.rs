@@ -41,75 +41,64 @@ pub(crate) fn plan_const(plan: &NetworkPlan, rt: &TokenStream) -> TokenStream {
     }
 }
 
-fn network(plan: &NetworkPlan, rt: &TokenStream) -> TokenStream {
-    let NetworkPlan {
-        master,
-        slaves,
-        boot_time,
-        response_time,
-        start_nodes,
-        start_all_nodes,
-        start_master,
-        reset_all_nodes,
-        stop_all_nodes,
-        receive,
-        transmit,
-    } = plan;
-    let master = master_plan(master, rt);
-    let slaves = borrowed(slaves.iter().map(|s| slave(s, rt)));
-    let boot_time = option(boot_time.map(duration));
-    let response_time = duration(*response_time);
-    let receive = borrowed(receive.iter().map(|l| link(l, rt)));
-    let transmit = borrowed(transmit.iter().map(|l| link(l, rt)));
-    quote! {
-        #rt::boot::NetworkPlan {
-            master: #master,
-            slaves: #slaves,
-            boot_time: #boot_time,
-            response_time: #response_time,
-            start_nodes: #start_nodes,
-            start_all_nodes: #start_all_nodes,
-            start_master: #start_master,
-            reset_all_nodes: #reset_all_nodes,
-            stop_all_nodes: #stop_all_nodes,
-            receive: #receive,
-            transmit: #transmit,
+/// `#rt::boot::Type { field: tokens, … }` of `value`, a `Type` of the
+/// runtime: every field is bound by name (a field the runtime adds is a
+/// compile error here) and rendered by its expression, in the order given.
+macro_rules! boot_struct {
+    ($rt:expr, $value:expr, $ty:ident { $($field:ident => $tokens:expr),* $(,)? }) => {{
+        let $ty { $($field),* } = $value;
+        // A field passed through as it is (`start => start`) binds itself again.
+        $(#[allow(clippy::redundant_locals)]
+        let $field = $tokens;)*
+        let rt = $rt;
+        quote! {
+            #rt::boot::$ty {
+                $($field: #$field,)*
+            }
         }
-    }
+    }};
+}
+
+fn network(plan: &NetworkPlan, rt: &TokenStream) -> TokenStream {
+    boot_struct!(rt, plan, NetworkPlan {
+        master => master_plan(master, rt),
+        slaves => borrowed(slaves.iter().map(|s| slave(s, rt))),
+        boot_time => option(boot_time.map(duration)),
+        response_time => duration(*response_time),
+        start_nodes => start_nodes,
+        start_all_nodes => start_all_nodes,
+        start_master => start_master,
+        reset_all_nodes => reset_all_nodes,
+        stop_all_nodes => stop_all_nodes,
+        receive => borrowed(receive.iter().map(|l| link(l, rt))),
+        transmit => borrowed(transmit.iter().map(|l| link(l, rt))),
+    })
 }
 
 fn master_plan(master: &MasterPlan, rt: &TokenStream) -> TokenStream {
-    let MasterPlan {
-        node,
-        heartbeat,
-        sync_period,
-        sync_overflow,
-    } = master;
-    let node = node_id(*node);
-    let heartbeat = option(heartbeat.map(duration));
-    let sync_period = option(sync_period.map(duration));
-    let sync_overflow = Literal::u8_unsuffixed(*sync_overflow);
-    quote! {
-        #rt::boot::MasterPlan {
-            node: #node,
-            heartbeat: #heartbeat,
-            sync_period: #sync_period,
-            sync_overflow: #sync_overflow,
-        }
-    }
+    boot_struct!(rt, master, MasterPlan {
+        node => node_id(*node),
+        heartbeat => option(heartbeat.map(duration)),
+        sync_period => option(sync_period.map(duration)),
+        sync_overflow => Literal::u8_unsuffixed(*sync_overflow),
+    })
 }
 
 fn slave(slave: &SlaveConfig, rt: &TokenStream) -> TokenStream {
-    let SlaveConfig {
-        name,
-        plan,
-        boot,
-        mandatory,
-        supervision,
-    } = slave;
-    let name: &str = name;
-    let plan = slave_plan(plan, rt);
-    let supervision = match supervision {
+    boot_struct!(rt, slave, SlaveConfig {
+        name => {
+            let name: &str = name;
+            quote!(alloc::borrow::Cow::Borrowed(#name))
+        },
+        plan => slave_plan(plan, rt),
+        boot => boot,
+        mandatory => mandatory,
+        supervision => supervision_of(supervision, rt),
+    })
+}
+
+fn supervision_of(supervision: &Supervision, rt: &TokenStream) -> TokenStream {
+    match supervision {
         Supervision::None => quote!(#rt::boot::Supervision::None),
         Supervision::Heartbeat(time) => {
             let time = duration(*time);
@@ -131,75 +120,30 @@ fn slave(slave: &SlaveConfig, rt: &TokenStream) -> TokenStream {
                 }
             }
         }
-    };
-    quote! {
-        #rt::boot::SlaveConfig {
-            name: alloc::borrow::Cow::Borrowed(#name),
-            plan: #plan,
-            boot: #boot,
-            mandatory: #mandatory,
-            supervision: #supervision,
-        }
     }
 }
 
 fn slave_plan(plan: &SlavePlan, rt: &TokenStream) -> TokenStream {
-    let SlavePlan {
-        node,
-        device_type,
-        vendor_id,
-        product_code,
-        revision_number,
-        serial_number,
-        software_version,
-        configuration_date_time,
-        configuration,
-        reset,
-        heartbeat,
-        start,
-    } = plan;
-    let node = node_id(*node);
-    let [
-        device_type,
-        vendor_id,
-        product_code,
-        revision_number,
-        serial_number,
-        software_version,
-    ] = [
-        device_type,
-        vendor_id,
-        product_code,
-        revision_number,
-        serial_number,
-        software_version,
-    ]
-    .map(|v| hex(*v));
-    let date_time = option(configuration_date_time.map(|(date, time)| {
-        let (date, time) = (hex(date), hex(time));
-        quote!((#date, #time))
-    }));
-    let configuration = borrowed(configuration.iter().map(write));
-    let reset = option(reset.map(|cmd| {
-        let cmd = nmt_command(cmd);
-        quote!(#rt::nmt::NmtCommand::#cmd)
-    }));
-    quote! {
-        #rt::boot::SlavePlan {
-            node: #node,
-            device_type: #device_type,
-            vendor_id: #vendor_id,
-            product_code: #product_code,
-            revision_number: #revision_number,
-            serial_number: #serial_number,
-            software_version: #software_version,
-            configuration_date_time: #date_time,
-            configuration: #configuration,
-            reset: #reset,
-            heartbeat: #heartbeat,
-            start: #start,
-        }
-    }
+    boot_struct!(rt, plan, SlavePlan {
+        node => node_id(*node),
+        device_type => hex(*device_type),
+        vendor_id => hex(*vendor_id),
+        product_code => hex(*product_code),
+        revision_number => hex(*revision_number),
+        serial_number => hex(*serial_number),
+        software_version => hex(*software_version),
+        configuration_date_time => option(configuration_date_time.map(|(date, time)| {
+            let (date, time) = (hex(date), hex(time));
+            quote!((#date, #time))
+        })),
+        configuration => borrowed(configuration.iter().map(write)),
+        reset => option(reset.map(|cmd| {
+            let cmd = nmt_command(cmd);
+            quote!(#rt::nmt::NmtCommand::#cmd)
+        })),
+        heartbeat => heartbeat,
+        start => start,
+    })
 }
 
 fn write(write: &ConfigWrite) -> TokenStream {
@@ -215,33 +159,15 @@ fn write(write: &ConfigWrite) -> TokenStream {
 }
 
 fn link(link: &PdoLink, rt: &TokenStream) -> TokenStream {
-    let PdoLink {
-        node,
-        number,
-        cob_id,
-        transmission,
-        len,
-        event_timer,
-        inhibit_time,
-    } = link;
-    let node = node_id(*node);
-    let number = Literal::u16_unsuffixed(*number);
-    let cob_id = hex(*cob_id);
-    let transmission = Literal::u8_unsuffixed(*transmission);
-    let len = Literal::u8_unsuffixed(*len);
-    let event_timer = Literal::u16_unsuffixed(*event_timer);
-    let inhibit_time = Literal::u16_unsuffixed(*inhibit_time);
-    quote! {
-        #rt::boot::PdoLink {
-            node: #node,
-            number: #number,
-            cob_id: #cob_id,
-            transmission: #transmission,
-            len: #len,
-            event_timer: #event_timer,
-            inhibit_time: #inhibit_time,
-        }
-    }
+    boot_struct!(rt, link, PdoLink {
+        node => node_id(*node),
+        number => Literal::u16_unsuffixed(*number),
+        cob_id => hex(*cob_id),
+        transmission => Literal::u8_unsuffixed(*transmission),
+        len => Literal::u8_unsuffixed(*len),
+        event_timer => Literal::u16_unsuffixed(*event_timer),
+        inhibit_time => Literal::u16_unsuffixed(*inhibit_time),
+    })
 }
 
 /// The variant name of `cmd` (every command a plan may hold).

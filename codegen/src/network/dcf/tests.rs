@@ -4,9 +4,9 @@ use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use super::*;
-use crate::ir::pdo::MappedObject;
 use crate::ir::{Access, DataType, Device, Entry, Literal, Object, ObjectKind, Origin, Value};
-use crate::network::config::{ConciseEntry, Pdo};
+use crate::network::config::ConciseEntry;
+use crate::network::config::test_pdo as pdo;
 use crate::network::model::{At, BusOptions, MasterSection, SlaveSection, Spot};
 
 fn entry(sub: u8, name: &str, data_type: DataType, default: Option<i128>) -> Entry {
@@ -89,18 +89,6 @@ fn slave(name: &str) -> SlaveSection {
             Box::new(device()),
         )
     }
-}
-
-fn pdo(number: u16, cob_id: u32, mapping: &[(u16, u8, u8)]) -> Pdo {
-    let mapping = mapping
-        .iter()
-        .map(|&(index, subindex, bits)| MappedObject {
-            index,
-            subindex,
-            bits,
-        })
-        .collect();
-    Pdo::new(number, cob_id, 1, mapping)
 }
 
 fn node(name: &str, slave: usize, node_id: u8) -> Node {

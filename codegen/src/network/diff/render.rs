@@ -2,14 +2,14 @@
 //! text (one line each, the node after the severity, and the summary),
 //! a Markdown table with a node column, and one JSON object whose changes
 //! carry `node` and `scope` (`wiring` or `device`) besides the device
-//! diff's fields.
+//! diff's fields. The rendering is the device diff's, on rows that carry
+//! the node.
 
-use std::fmt::Write;
+use std::borrow::Cow;
 
 use super::NetChange;
 use crate::diff::Summary;
-use crate::diff::render::{md, string, summary_of, value};
-use crate::text::{code_span, terminal_line};
+use crate::diff::render::{Row, json_of, markdown_of, row, summary_of, text_of};
 
 /// `5 changes: 2 breaking, 1 additive, 2 compatible`.
 pub fn summary(changes: &[NetChange]) -> String {
@@ -17,114 +17,33 @@ pub fn summary(changes: &[NetChange]) -> String {
     summary_of(&s, changes.len())
 }
 
+fn rows(changes: &[NetChange]) -> Vec<Row<'_>> {
+    changes
+        .iter()
+        .map(|c| row!(c, Some((&c.node, c.kind.scope())), Cow::Borrowed(&c.place)))
+        .collect()
+}
+
 /// One line per change (severity, node, where, kind, Rust path, message)
 /// and the summary line; the node column is as wide as the longest name.
 pub fn text(changes: &[NetChange]) -> String {
-    let width = changes
-        .iter()
-        .map(|c| terminal_line(&c.node).chars().count())
-        .max()
-        .unwrap_or(0);
-    let mut out = String::new();
-    for c in changes {
-        let path = c
-            .rust_path
-            .as_deref()
-            .map(|p| format!(" {}", code_span(p)))
-            .unwrap_or_default();
-        let _ = writeln!(
-            out,
-            "{:<10} {:<width$} {:<14} {}{path}: {}",
-            c.severity.as_str(),
-            terminal_line(&c.node),
-            terminal_line(&c.place),
-            c.kind.as_str(),
-            terminal_line(&c.message)
-        );
-    }
-    let _ = writeln!(out, "{}", summary(changes));
-    out
+    text_of(&rows(changes), &summary(changes))
 }
 
 /// A Markdown table (severity, node, where, kind, Rust path, change) and
 /// the summary, for a review comment.
 pub fn markdown(old: &str, new: &str, changes: &[NetChange]) -> String {
-    let mut out = String::new();
-    let _ = writeln!(
-        out,
-        "### Network changes: {} → {}\n",
-        md(&code_span(old)),
-        md(&code_span(new))
-    );
-    if !changes.is_empty() {
-        out.push_str(
-            "| severity | node | where | kind | Rust path | change |\n|---|---|---|---|---|---|\n",
-        );
-        for c in changes {
-            let severity = match c.severity {
-                crate::diff::Severity::Breaking => "**breaking**",
-                crate::diff::Severity::Additive => "additive",
-                crate::diff::Severity::Compatible => "compatible",
-            };
-            let path = c
-                .rust_path
-                .as_deref()
-                .map(|p| md(&code_span(p)))
-                .unwrap_or_default();
-            let _ = writeln!(
-                out,
-                "| {severity} | {} | {} | `{}` | {path} | {} |",
-                md(&code_span(&c.node)),
-                md(&c.place),
-                c.kind.as_str(),
-                md(&c.message)
-            );
-        }
-        out.push('\n');
-    }
-    let _ = writeln!(out, "{}", summary(changes));
-    out
+    markdown_of(
+        "Network changes",
+        old,
+        new,
+        &rows(changes),
+        &summary(changes),
+    )
 }
 
 /// One JSON object: `{"old", "new", "changes": [...]}`, two-space
 /// indentation, keys in a fixed order.
 pub fn json(old: &str, new: &str, changes: &[NetChange]) -> String {
-    let mut out = String::new();
-    out.push_str("{\n");
-    let _ = writeln!(out, "  \"old\": {},", string(old));
-    let _ = writeln!(out, "  \"new\": {},", string(new));
-    if changes.is_empty() {
-        out.push_str("  \"changes\": []\n}\n");
-        return out;
-    }
-    out.push_str("  \"changes\": [\n");
-    for (i, c) in changes.iter().enumerate() {
-        out.push_str("    {\n");
-        let _ = writeln!(out, "      \"node\": {},", string(&c.node));
-        let _ = writeln!(out, "      \"scope\": {},", string(c.kind.scope()));
-        let _ = writeln!(out, "      \"index\": {},", c.index);
-        let _ = writeln!(
-            out,
-            "      \"subindex\": {},",
-            c.subindex.map_or("null".to_string(), |s| s.to_string())
-        );
-        let _ = writeln!(out, "      \"where\": {},", string(&c.place));
-        let _ = writeln!(out, "      \"kind\": {},", string(c.kind.as_str()));
-        let _ = writeln!(out, "      \"severity\": {},", string(c.severity.as_str()));
-        let _ = writeln!(
-            out,
-            "      \"rust_path\": {},",
-            c.rust_path.as_deref().map_or("null".to_string(), string)
-        );
-        let _ = writeln!(out, "      \"old\": {},", value(c.old.as_ref()));
-        let _ = writeln!(out, "      \"new\": {},", value(c.new.as_ref()));
-        let _ = writeln!(out, "      \"message\": {}", string(&c.message));
-        out.push_str(if i + 1 == changes.len() {
-            "    }\n"
-        } else {
-            "    },\n"
-        });
-    }
-    out.push_str("  ]\n}\n");
-    out
+    json_of(old, new, &rows(changes))
 }

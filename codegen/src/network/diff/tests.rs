@@ -4,7 +4,8 @@
 use super::*;
 use crate::diff::Severity::{Additive, Breaking, Compatible};
 use crate::ir::pdo::MappedObject;
-use crate::network::config::{Node, Pdo};
+use crate::network::config::Node;
+use crate::network::config::test_pdo as pdo;
 use crate::network::model::{At, BusOptions, MasterSection, SdoItem, SlaveSection, Spot};
 
 fn at<T>(value: T) -> At<T> {
@@ -25,18 +26,6 @@ fn slave(name: &str) -> SlaveSection {
             Box::new(device),
         )
     }
-}
-
-fn pdo(number: u16, cob_id: u32, mapping: &[(u16, u8, u8)]) -> Pdo {
-    let mapping = mapping
-        .iter()
-        .map(|&(index, subindex, bits)| MappedObject {
-            index,
-            subindex,
-            bits,
-        })
-        .collect();
-    Pdo::new(number, cob_id, 1, mapping)
 }
 
 fn node(name: &str, slave: usize, node_id: u8) -> Node {
