@@ -1,6 +1,6 @@
 //! The canonical names and built-in meanings of standard objects: CiA 301 and the device
 //! profiles, one file per profile, as plain data (index, optional sub, the
-//! Rust name and the standard's own name text; and, in [`meaning`], the
+//! Rust name and the standard's own name text; and, in `meaning`, the
 //! bit fields, states, named values and units the standard fixes). The generator names a
 //! standard object by this table, not by the vendor's spelling, so a
 //! firmware update that renames `ParameterName` renames nothing in Rust;
@@ -8,7 +8,7 @@
 //! so that no vendor object takes a standard name.
 //!
 //! The 0x6000–0x6FFF range means different things in different device
-//! profiles; [`Profile::of`] picks the one a device implements.
+//! profiles; `Profile::of` picks the one a device implements.
 
 use std::collections::HashSet;
 use std::sync::OnceLock;
